@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+#include "msgraphs/platform/realtime.hpp"
+
+#include <gtest/gtest.h>
+
+#include <pthread.h>
+
+#include <thread>
+
+namespace msgraphs::platform {
+namespace {
+
+TEST(Realtime, OutOfRangePriorityIsInvalidArgument) {
+  const Status s = SetCurrentThreadRealtime(1000);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().code, Errc::kInvalidArgument);
+}
+
+TEST(Realtime, ProbeAgreesWithAnActualAttempt) {
+  const RealtimeCapabilities caps = ProbeRealtimeCapabilities();
+  EXPECT_GE(caps.max_fifo_priority, 1);
+  // Try for real on a separate thread: the outcome must match the probe, and a refusal must
+  // say "permission denied" rather than fail some other way.
+  Status attempt = Ok();
+  std::thread t([&attempt] { attempt = SetCurrentThreadRealtime(1); });
+  t.join();
+  EXPECT_EQ(attempt.has_value(), caps.can_use_fifo);
+  if (!attempt) {
+    EXPECT_EQ(attempt.error().code, Errc::kPermissionDenied);
+  }
+}
+
+TEST(Realtime, ThreadNameIsTruncatedTo15Characters) {
+  std::thread t([] {
+    ASSERT_TRUE(SetCurrentThreadName("msgraphs-lidar-receive"));
+    char name[32] = {};
+    pthread_getname_np(pthread_self(), name, sizeof(name));
+    EXPECT_STREQ(name, "msgraphs-lidar-");
+  });
+  t.join();
+}
+
+}  // namespace
+}  // namespace msgraphs::platform
