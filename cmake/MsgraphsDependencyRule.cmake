@@ -130,7 +130,7 @@ function(_msgraphs_check_item target layer raw_item interface)
   endif()
   if(class IN_LIST _msgraphs_private_only AND interface AND NOT link_only)
     _msgraphs_rule_error(${target} ${layer}
-      "'${item}' (${class}) in its public interface; ${class} must be linked PRIVATE" ${layer})
+      "'${item}' (${class}) in its public interface (${class} must be linked PRIVATE)" ${layer})
   endif()
 endfunction()
 

@@ -53,8 +53,11 @@ done
 
 # Fix-up 3: CMake package files hard-code /usr/lib/aarch64-linux-gnu/... (Ceres's LAPACK,
 # fastrtps/fastcdr IMPORTED_LOCATION); re-root them, or ninja looks for the host's files.
-grep -rlE '"/usr/|;/usr/' "$libdir/cmake" "$sysroot/usr/share/cmake" "$sysroot"/usr/share/*/cmake \
-    "$sysroot/usr/lib/cmake" 2>/dev/null | sort -u \
+cmake_dirs=()
+for d in "$libdir/cmake" "$sysroot/usr/share/cmake" "$sysroot"/usr/share/*/cmake "$sysroot/usr/lib/cmake"; do
+  if [[ -d "$d" ]]; then cmake_dirs+=("$d"); fi
+done
+grep -rlE '"/usr/|;/usr/' "${cmake_dirs[@]}" | sort -u \
   | xargs -r sed -i -E "s#([\";])/usr/#\1$sysroot/usr/#g"
 
 echo "$stamp_value" > "$stamp"
