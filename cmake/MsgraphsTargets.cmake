@@ -24,6 +24,13 @@ function(msgraphs_target_defaults target)
   endif()
 endfunction()
 
+# Tags <target> with its layer and lists it for msgraphs_check_dependencies(). Targets not made
+# by the helpers below (generated code, OBJECT libraries) call this directly.
+function(msgraphs_register_target target layer)
+  set_property(TARGET ${target} PROPERTY MSGRAPHS_LAYER ${layer})
+  set_property(GLOBAL APPEND PROPERTY MSGRAPHS_TARGETS ${target})
+endfunction()
+
 # msgraphs_add_library(<name> LAYER <layer> [SOURCES ...] [HEADER_ONLY])
 # Creates msgraphs_<name> with alias msgraphs::<name>, public include dir ./include, tagged with
 # its layer for the dependency rule (cmake/MsgraphsDependencyRule.cmake).
@@ -46,8 +53,7 @@ function(msgraphs_add_library name)
     msgraphs_target_defaults(${target})
   endif()
   add_library(msgraphs::${name} ALIAS ${target})
-  set_property(TARGET ${target} PROPERTY MSGRAPHS_LAYER ${arg_LAYER})
-  set_property(GLOBAL APPEND PROPERTY MSGRAPHS_TARGETS ${target})
+  msgraphs_register_target(${target} ${arg_LAYER})
 endfunction()
 
 # msgraphs_add_executable(<name> LAYER <runtime|tools|tests|bench> SOURCES ...)
@@ -58,6 +64,5 @@ function(msgraphs_add_executable name)
   endif()
   add_executable(${name} ${arg_SOURCES})
   msgraphs_target_defaults(${name})
-  set_property(TARGET ${name} PROPERTY MSGRAPHS_LAYER ${arg_LAYER})
-  set_property(GLOBAL APPEND PROPERTY MSGRAPHS_TARGETS ${name})
+  msgraphs_register_target(${name} ${arg_LAYER})
 endfunction()
