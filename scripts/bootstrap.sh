@@ -28,7 +28,7 @@ host_packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   iproute2 nftables
 )
-cross_packages=(g++-aarch64-linux-gnu qemu-user-static mmdebstrap)
+cross_packages=(g++-aarch64-linux-gnu qemu-user-static mmdebstrap file)  # file: CI shows the binaries' architecture
 
 missing_packages() {
   local p status

@@ -13,7 +13,9 @@
 namespace msgraphs::platform {
 
 /// mlockall(MCL_CURRENT | MCL_FUTURE), then touches `stack_prefault_bytes` of the calling
-/// thread's stack so later page faults cannot stall it. kPermissionDenied without privilege.
+/// thread's stack so later page faults cannot stall it. `stack_prefault_bytes` must stay well
+/// below the calling thread's stack size (it is reserved in one frame). kPermissionDenied without
+/// privilege; kIo with ENOMEM when RLIMIT_MEMLOCK is smaller than the process.
 Status LockProcessMemory(std::size_t stack_prefault_bytes = 256 * 1024);
 
 /// Moves the calling thread to SCHED_FIFO at `priority` (1..99). kPermissionDenied without
