@@ -29,6 +29,22 @@ void Rotate(const Pose3& q, double& x, double& y, double& z) {
 
 }  // namespace
 
+Pose3 OdometryIntegrator::Integrate(const Twist& twist, double duration_s, double period_s) {
+  // Constant body velocity over `duration_s`, in sub-steps of about one sample period; each
+  // sub-step moves along the chord at half its rotation (midpoint rule), which follows an arc
+  // to second order, as the encoders themselves would have reported it.
+  int steps = static_cast<int>(std::ceil(duration_s / period_s));
+  if (steps < 1) steps = 1;
+  if (steps > 256) steps = 256;
+  const double h = duration_s / steps;
+  const Pose3 half = PoseFromDelta(0, 0, 0, 0.5 * twist.wroll * h, 0.5 * twist.wpitch * h, 0.5 * twist.wyaw * h);
+  const Pose3 move = PoseFromDelta(twist.vx * h, twist.vy * h, twist.vz * h, 0, 0, 0);
+  const Pose3 sub = Compose(Compose(half, move), half);
+  Pose3 total;
+  for (int i = 0; i < steps; ++i) total = Compose(total, sub);
+  return total;
+}
+
 Pose3 Compose(const Pose3& a, const Pose3& b) {
   Pose3 c;
   double x = b.x_m, y = b.y_m, z = b.z_m;
@@ -142,11 +158,15 @@ Expected<OdometryPose> OdometryIntegrator::Add(const OdomSample& sample) {
     ++stats_.gaps;
     stats_.missing_samples += static_cast<std::uint64_t>(missing);
     if (missing_s <= config_.max_bridge.seconds()) {
-      // Mean of the velocities either side of the gap over the missing time.
-      const auto mean = [&](double a, double b) { return 0.5 * (a + b) * missing_s; };
-      step = PoseFromDelta(mean(last_twist_.vx, twist.vx), mean(last_twist_.vy, twist.vy),
-                           mean(last_twist_.vz, twist.vz), mean(last_twist_.wroll, twist.wroll),
-                           mean(last_twist_.wpitch, twist.wpitch), mean(last_twist_.wyaw, twist.wyaw));
+      // Mean of the velocities either side of the gap, over the missing time.
+      Twist mean;
+      mean.vx = 0.5 * (last_twist_.vx + twist.vx);
+      mean.vy = 0.5 * (last_twist_.vy + twist.vy);
+      mean.vz = 0.5 * (last_twist_.vz + twist.vz);
+      mean.wroll = 0.5 * (last_twist_.wroll + twist.wroll);
+      mean.wpitch = 0.5 * (last_twist_.wpitch + twist.wpitch);
+      mean.wyaw = 0.5 * (last_twist_.wyaw + twist.wyaw);
+      step = Integrate(mean, missing_s, period_estimate_s_);
       out.flags |= kPoseBridged;
       ++stats_.bridged;
       stats_.bridged_seconds += missing_s;
@@ -161,8 +181,7 @@ Expected<OdometryPose> OdometryIntegrator::Add(const OdomSample& sample) {
   if (valid) {
     step = Compose(step, PoseFromDelta(v.dx_m, v.dy_m, v.dz_m, v.droll_rad, v.dpitch_rad, v.dyaw_rad));
   } else {
-    step = Compose(step, PoseFromDelta(twist.vx * own_s, twist.vy * own_s, twist.vz * own_s,
-                                       twist.wroll * own_s, twist.wpitch * own_s, twist.wyaw * own_s));
+    step = Compose(step, Integrate(twist, own_s, period_estimate_s_));
     ++stats_.bridged;
     stats_.bridged_seconds += own_s;
   }

@@ -88,6 +88,8 @@ class OdometryIntegrator {
     double vx = 0, vy = 0, vz = 0, wroll = 0, wpitch = 0, wyaw = 0;
   };
 
+  static Pose3 Integrate(const Twist& twist, double duration_s, double period_s);
+
   OdometryIntegratorConfig config_;
   ClockOffsetFilter clock_;
   bool started_ = false;
