@@ -43,7 +43,8 @@ struct UdpReceiverStats {
   std::uint64_t bytes = 0;
   std::uint64_t truncated = 0;  ///< longer than max_payload_bytes: dropped
   std::uint64_t foreign = 0;    ///< wrong source or size: dropped
-  /// Datagrams the kernel dropped because the socket buffer was full (SO_RXQ_OVFL).
+  /// Datagrams the kernel dropped because the socket buffer was full (SO_RXQ_OVFL). The kernel
+  /// reports drops with the next datagram it queues, so the count lags until traffic resumes.
   std::uint64_t kernel_drops = 0;
   std::uint64_t receive_calls = 0;
   std::size_t peak_batch = 0;
