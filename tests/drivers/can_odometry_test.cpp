@@ -375,6 +375,7 @@ TEST(Candump, MalformedLinesGiveAReason) {
            "(1700000000.123456) can0 120#00 X",      // junk after
            "(1700000000.123456) can0 120#R9",        // RTR length
            "(1700000000.123456) averyveryverylongifname 120#00",
+           "(160977999230.000000) can0 120#00",      // int64 nanosecond overflow (fuzzer find)
        }) {
     auto r = ParseCandumpLine(bad);
     ASSERT_FALSE(r.has_value()) << bad;

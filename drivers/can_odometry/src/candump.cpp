@@ -114,6 +114,8 @@ Expected<CandumpLine> ParseCandumpLine(std::string_view text) {
     if (c < '0' || c > '9') return Error{Errc::kMalformed, "candump: timestamp is not decimal"};
     sub = sub * 10 + (c - '0');
   }
+  // Time is kept as int64 nanoseconds: years beyond 2255 do not fit (found by fuzzing).
+  if (seconds > 9'000'000'000) return Error{Errc::kMalformed, "candump: timestamp beyond the year 2255"};
   if (fraction.size() == 6) sub *= 1000;
   line.stamp = UnixTime::FromNanoseconds(seconds * 1'000'000'000 + sub);
 
