@@ -4,6 +4,9 @@
 #
 #   scripts/bootstrap.sh            host build: compilers, Eigen, Ceres, Fast DDS, libgpiod, PCL, tests
 #   scripts/bootstrap.sh --cross    also the aarch64 cross toolchain, qemu-user and the arm64 sysroot
+#   scripts/bootstrap.sh --fuzz     also clang and its libFuzzer runtime (scripts/fuzz.sh)
+#   scripts/bootstrap.sh --vm       also the kernel-in-the-loop VM (qemu-system, a Debian kernel
+#                                   with vcan and gpio-sim; scripts/vm/prepare.sh)
 #
 # Why a sysroot and not `dpkg --add-architecture arm64`: libceres-dev:arm64 cannot be co-installed
 # with the amd64 one (glog/gflags are not Multi-Arch: same), see docs/cross-build.md.
@@ -11,11 +14,15 @@ set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 cross=0
+fuzz=0
+vm=0
 for arg in "$@"; do
   case "$arg" in
     --cross) cross=1 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
-    *) echo "bootstrap: unknown argument '$arg' (expected --cross)" >&2; exit 2 ;;
+    --fuzz) fuzz=1 ;;
+    --vm) vm=1 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    *) echo "bootstrap: unknown argument '$arg' (expected --cross, --fuzz or --vm)" >&2; exit 2 ;;
   esac
 done
 
@@ -29,6 +36,7 @@ host_packages=(
   iproute2 nftables
 )
 cross_packages=(g++-aarch64-linux-gnu qemu-user-static mmdebstrap file)  # file: CI shows the binaries' architecture
+fuzz_packages=(clang libclang-rt-14-dev)
 
 missing_packages() {
   local p status
@@ -42,6 +50,7 @@ if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); else sudo_cmd=(); fi
 
 wanted=("${host_packages[@]}")
 (( cross )) && wanted+=("${cross_packages[@]}")
+(( fuzz )) && wanted+=("${fuzz_packages[@]}")
 mapfile -t todo < <(missing_packages "${wanted[@]}")
 if (( ${#todo[@]} )); then
   echo "bootstrap: installing ${#todo[@]} missing package(s): ${todo[*]}"
@@ -58,4 +67,8 @@ fi
 
 if (( cross )); then
   "${sudo_cmd[@]}" "$here/make-arm64-sysroot.sh"
+fi
+
+if (( vm )); then
+  "$here/vm/prepare.sh"
 fi

@@ -79,12 +79,11 @@ Expected<UdpReceiver> UdpReceiver::Open(const UdpReceiverConfig& config) {
   if (::getsockopt(fd, SOL_SOCKET, SO_RCVBUF, &granted, &len) == 0) {
     receiver.stats_.receive_buffer_bytes = granted;
   }
-  if (::setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof(one)) != 0) {
-    return Error{Errc::kIo, "udp: SO_TIMESTAMPNS failed", errno};
-  }
-  if (::setsockopt(fd, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof(one)) != 0) {
-    return Error{Errc::kIo, "udp: SO_RXQ_OVFL failed", errno};
-  }
+  // Every Linux kernel has both options; emulators (qemu-user) may not translate them. Then
+  // datagrams are stamped on arrival in user space and drops cannot be counted: the stats say so.
+  receiver.stats_.kernel_timestamps =
+      ::setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof(one)) == 0;
+  receiver.stats_.drop_counting = ::setsockopt(fd, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof(one)) == 0;
   const sockaddr_in address = ToSockaddr(config.bind);
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
     return Error{Errc::kIo, "udp: bind failed (port in use or not permitted)", errno};
@@ -152,6 +151,7 @@ std::size_t UdpReceiver::ReceiveBatch(int& error_out) {
     return 0;
   }
   error_out = 0;
+  const UnixTime now = stats_.kernel_timestamps ? UnixTime() : UnixNow();
   std::size_t accepted = 0;
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -183,8 +183,10 @@ std::size_t UdpReceiver::ReceiveBatch(int& error_out) {
       continue;
     }
     ReceivedDatagram& d = b.accepted[accepted++];
-    d.kernel_time = UnixTime::FromNanoseconds(static_cast<std::int64_t>(stamp.tv_sec) * 1'000'000'000 +
-                                              stamp.tv_nsec);
+    d.kernel_time = stats_.kernel_timestamps
+                        ? UnixTime::FromNanoseconds(static_cast<std::int64_t>(stamp.tv_sec) * 1'000'000'000 +
+                                                    stamp.tv_nsec)
+                        : now;
     d.source = {source_address, ntohs(from.sin_port)};
     d.payload = {b.payload.data() + k * slot, length};
     ++stats_.datagrams;

@@ -33,7 +33,8 @@ struct UdpReceiverConfig {
 };
 
 struct ReceivedDatagram {
-  UnixTime kernel_time;  ///< SO_TIMESTAMPNS: when the kernel received it (CLOCK_REALTIME)
+  /// SO_TIMESTAMPNS: when the kernel received it (CLOCK_REALTIME); see stats().kernel_timestamps.
+  UnixTime kernel_time;
   Ipv4Endpoint source;
   std::span<const std::uint8_t> payload;  ///< valid until the next Receive
 };
@@ -49,6 +50,11 @@ struct UdpReceiverStats {
   std::uint64_t receive_calls = 0;
   std::size_t peak_batch = 0;
   int receive_buffer_bytes = 0;  ///< what the kernel granted (it reports twice the request)
+  /// False where the kernel (or an emulator) refused SO_TIMESTAMPNS: times are then taken in
+  /// user space when the batch is read, later and noisier.
+  bool kernel_timestamps = true;
+  /// False where SO_RXQ_OVFL was refused: kernel_drops then stays 0 whatever is lost.
+  bool drop_counting = true;
 };
 
 class UdpReceiver {
