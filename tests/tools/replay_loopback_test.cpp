@@ -19,6 +19,8 @@
 #include "../drivers/velodyne_test_packets.hpp"
 #include "msgraphs/drivers/pcap/pcap_writer.hpp"
 #include "msgraphs/drivers/velodyne/data_packet_decoder.hpp"
+#include "msgraphs/drivers/velodyne/scan_assembler.hpp"
+#include "msgraphs/drivers/velodyne/velodyne_source.hpp"
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/udp_socket.hpp"
 #include "test_data.hpp"
@@ -116,6 +118,73 @@ TEST(ReplayLoopback, RecorderWritesWhatTheReplaySends) {
     }
   }
   EXPECT_GE(recorded.position.size(), original.position.size() - 1);  // the last may follow the last data packet
+}
+
+
+TEST(ReplayLoopback, VelodyneSourceAssemblesTheSameScansAsTheFile) {
+  namespace vel = drivers::velodyne;
+  std::filesystem::path path;
+  MSGRAPHS_REQUIRE_DATA("pcap/mrpt_sample_velodyne_vlp16_gps.pcap", path);
+  const auto capture = test::LoadCapture(path.string());
+
+  // Scans from the file directly.
+  std::vector<std::vector<vel::VelodynePoint>> expected;
+  {
+    const auto decoder = vel::DataPacketDecoder::Create({}).value();
+    auto assembler = vel::ScanAssembler::Create({}).value();
+    std::vector<vel::VelodynePoint> out(vel::kMaxPointsPerPacket);
+    for (const auto& p : capture.data) {
+      auto r = decoder.Decode(p.bytes, out).value();
+      if (assembler.AddPacket(p.time, r, std::span(out).first(r.points))) {
+        expected.emplace_back(assembler.completed().points.begin(), assembler.completed().points.end());
+      }
+    }
+  }
+  ASSERT_GE(expected.size(), 3u);
+
+  vel::VelodyneSourceConfig config;
+  config.bind_address = kIpv4Loopback;
+  config.data_port = 0;
+  config.position_port = 0;
+  auto source = vel::VelodyneSource::Open(config).value();
+  const pid_t replay = Spawn({MSGRAPHS_REPLAY_TOOL, "--pcap", path.string(), "--to", "127.0.0.1", "--data-port",
+                              std::to_string(source.data_port()), "--position-port",
+                              std::to_string(source.position_port())});
+  std::vector<std::vector<vel::VelodynePoint>> live;
+  std::vector<double> spans_s;
+  int code = -1;
+  SteadyTime quiet_until = platform::SteadyNow() + Duration::FromSeconds(10.0);
+  while (platform::SteadyNow() < quiet_until) {
+    if (source.Poll(platform::SteadyNow() + Duration::FromMilliseconds(50)).value()) {
+      live.emplace_back(source.scan().points.begin(), source.scan().points.end());
+      spans_s.push_back((source.scan().end_time - source.scan().start_time).seconds());
+    }
+    if (code < 0 && Exited(replay, code)) quiet_until = platform::SteadyNow() + Duration::FromMilliseconds(200);
+  }
+  ASSERT_EQ(code, 0);
+  const auto stats = source.stats();
+  EXPECT_EQ(stats.data_packets, 293u);
+  EXPECT_EQ(stats.malformed_data, 0u);
+  EXPECT_EQ(stats.position_packets, 57u);
+  EXPECT_EQ(stats.data_udp.kernel_drops, 0u);
+  ASSERT_TRUE(source.position().has_value());
+  EXPECT_EQ(source.position()->pps, vel::PpsStatus::kLocked);
+
+  // Same scans, same points; only the time base differs (device clock mapped to arrival).
+  ASSERT_EQ(live.size(), expected.size());
+  for (std::size_t s = 0; s < live.size(); ++s) {
+    ASSERT_EQ(live[s].size(), expected[s].size()) << "scan " << s;
+    for (std::size_t i = 0; i < live[s].size(); ++i) {
+      const auto& a = live[s][i];
+      const auto& b = expected[s][i];
+      ASSERT_TRUE(a.x_m == b.x_m && a.y_m == b.y_m && a.z_m == b.z_m && a.azimuth_cdeg == b.azimuth_cdeg &&
+                  a.laser_id == b.laser_id && a.intensity == b.intensity)
+          << "scan " << s << " point " << i;
+    }
+    if (s > 0) {
+      EXPECT_NEAR(spans_s[s], 0.1, 0.01) << "a 10 Hz rotation by the sensor's clock";
+    }
+  }
 }
 
 }  // namespace
