@@ -18,6 +18,7 @@
 #include "msgraphs/drivers/can_odometry/crc8.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_frames.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_integrator.hpp"
+#include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/can_odometry/sample_assembler.hpp"
 #include "test_data.hpp"
 
@@ -319,6 +320,38 @@ TEST(OdometryIntegrator, PerFrameDecodingAndIntegrationAllocateNothing) {
   }
   EXPECT_EQ(scope.allocations(), 0u);
   EXPECT_EQ(poses, 1000u);
+}
+
+
+TEST(OdometryStream, EveryBadFrameIsCountedByKind) {
+  auto stream = OdometryStream::Create({}).value();
+  Simulated sim;
+  int poses = 0;
+  for (int i = 0; i < 50; ++i) {
+    const OdomSample s = sim.Next();
+    auto frames = EncodeOdomSample(s.values);
+    if (i == 10) frames[0].data[1] ^= 0x40;  // CRC failure: sample 10 is lost and bridged
+    if (i == 20) frames[1].length = 6;        // bad length: sample 20 is lost and bridged
+    for (const CanFrame& f : frames) poses += stream.Add(f, s.receive_time);
+    CanFrame foreign;
+    foreign.id = 0x343;
+    foreign.length = 8;
+    static_cast<void>(stream.Add(foreign, s.receive_time));
+    if (i == 30) {
+      CanFrame error;
+      error.error = true;
+      static_cast<void>(stream.Add(error, s.receive_time));
+    }
+  }
+  const auto stats = stream.stats();
+  EXPECT_EQ(poses, 48);
+  EXPECT_EQ(stats.frames, 50u * 4u + 1u);
+  EXPECT_EQ(stats.foreign_ids, 50u);
+  EXPECT_EQ(stats.crc_errors, 1u);
+  EXPECT_EQ(stats.bad_frames, 2u);
+  EXPECT_EQ(stats.pairing.incomplete_samples, 2u);
+  EXPECT_EQ(stats.integration.missing_samples, 2u);
+  EXPECT_NEAR(stream.pose().T_odom_base.x_m, 49 * 0.02, 1e-6) << "lost samples are bridged, not dropped";
 }
 
 // ---- candump -----------------------------------------------------------------------------------
