@@ -140,7 +140,7 @@ TEST(SampleAssembler, MissingFramesMakeIncompleteSamplesCountedOnce) {
 struct Simulated {
   // A robot moving at v m/s and w rad/s, sampled at 50 Hz with the DBC's quantisation.
   double v = 1.0, w = 0.0;
-  std::uint32_t time_us = 4'000'000'000u;  // close to the 32-bit wrap on purpose
+  std::uint32_t time_us = 4'290'000'000u;  // the 32-bit microsecond clock wraps after 248 samples
   std::uint8_t sequence = 250;
   UnixTime host = UnixTime::FromSeconds(1700000000.0);
 
