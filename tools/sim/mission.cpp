@@ -194,7 +194,7 @@ std::optional<Mission> PlanMission(const World& world, const Scene& scene, const
   std::vector<std::vector<Eigen::Vector2d>> free;
   for (std::size_t r = 0; r < world.rooms.size(); ++r) {
     if (world.rooms[r].level != config.level) continue;
-    auto cells = grid.FreeCells(static_cast<int>(r), config.robot_radius_m + 0.4);
+    auto cells = grid.FreeCells(static_cast<int>(r), config.robot_radius_m + 0.2);
     if (cells.size() < 4) continue;  // too cluttered or too small to walk into
     rooms.push_back(static_cast<int>(r));
     free.push_back(std::move(cells));
