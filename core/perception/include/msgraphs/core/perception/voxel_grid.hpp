@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// Voxel downsampling on a bounded hash grid: every occupied voxel becomes the centroid of its
+// points. Capacity (points and voxels) is fixed at Init; a call never allocates. When a cloud
+// occupies more voxels than the capacity, points falling in new voxels are dropped and counted
+// (`overflowed`), and the call returns kCapacityExceeded after producing everything it could.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "msgraphs/base/bounded_vector.hpp"
+#include "msgraphs/base/expected.hpp"
+
+namespace msgraphs::core {
+
+/// Voxel key: integer coordinates packed into 63 bits (21 bits each, +-2^20 voxels per axis).
+/// false when the point is too far out (|coordinate| / leaf >= 2^20) or not finite.
+bool VoxelKey(const Eigen::Vector3f& p, float inverse_leaf, std::uint64_t& key);
+
+struct VoxelGridStats {
+  std::size_t input = 0;
+  std::size_t output = 0;
+  std::size_t rejected = 0;    ///< non-finite or out-of-range coordinates
+  std::size_t overflowed = 0;  ///< points whose voxel did not fit
+};
+
+class VoxelDownsampler {
+ public:
+  void Init(std::size_t max_voxels);
+  std::size_t capacity() const { return sum_.size(); }
+
+  /// Appends the centroids to `out` (cleared first). kInvalidArgument for a leaf <= 0.
+  Status Downsample(std::span<const Eigen::Vector3f> points, float leaf_m, BoundedVector<Eigen::Vector3f>& out);
+  const VoxelGridStats& stats() const { return stats_; }
+  std::size_t peak_voxels() const { return peak_; }
+
+ private:
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> slot_epoch_;
+  std::vector<std::uint32_t> slot_value_;
+  std::vector<Eigen::Vector3d> sum_;
+  std::vector<std::uint32_t> count_;
+  std::uint32_t epoch_ = 0;
+  std::size_t peak_ = 0;
+  VoxelGridStats stats_;
+};
+
+/// Keeps finite points with min_range_m <= |p| <= max_range_m; returns how many were rejected
+/// as non-finite (`rejected_non_finite`) and out of range.
+struct RangeFilterStats {
+  std::size_t kept = 0, out_of_range = 0, non_finite = 0, overflowed = 0;
+};
+RangeFilterStats RangeFilter(std::span<const Eigen::Vector3f> points, float min_range_m, float max_range_m,
+                             BoundedVector<Eigen::Vector3f>& out);
+
+}  // namespace msgraphs::core
