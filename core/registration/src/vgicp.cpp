@@ -178,7 +178,13 @@ Expected<VgicpResult> Vgicp::Align(std::span<const Eigen::Vector3f> source_point
       }
       lambda = lambda > 0.0 ? lambda * 10.0 : 1e-6;
     }
-    if (!accepted) break;  // no step lowers the cost: a minimum (or a flat direction)
+    if (!accepted) {
+      // No step lowers the cost, not even a heavily damped one: a minimum, to the precision
+      // the damped step shows (fast_gicp's criterion).
+      result.converged = delta.allFinite() && delta.tail<3>().norm() < config.rotation_eps_rad &&
+                         delta.head<3>().norm() < config.translation_eps_m;
+      break;
+    }
     const bool small = delta.tail<3>().norm() < config.rotation_eps_rad && delta.head<3>().norm() < config.translation_eps_m;
     lin = evaluate(T, true);
     if (lin.count < 10) return Error{Errc::kDegenerate, "vgicp: the alignment left the target"};
