@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: MIT
+// A bounded 2-D free-space grid accumulated from keyframes (the part of voxblox's ESDF that
+// room segmentation needs): every lidar ray marks the cells it crosses free; points in the
+// obstacle height band mark their cell occupied. Fixed size and origin from configuration;
+// points outside the grid are counted and ignored. Integrate allocates nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "msgraphs/base/expected.hpp"
+
+namespace msgraphs::core {
+
+struct FreeSpaceGridConfig {
+  float resolution_m = 0.1f;
+  int width = 1024;   ///< cells along x
+  int height = 1024;  ///< cells along y
+  Eigen::Vector2f origin_m{-51.2f, -51.2f};  ///< map coordinates of cell (0, 0)'s corner
+  float obstacle_min_height_m = 0.25f;  ///< above the floor: below is floor and clutter-free space
+  float obstacle_max_height_m = 2.0f;   ///< above: ceiling, lamps; they do not block walking
+  float max_range_m = 25.0f;
+
+  Status Validate() const;
+};
+
+class FreeSpaceGrid {
+ public:
+  enum class Cell : std::uint8_t { kUnknown, kFree, kOccupied };
+
+  Status Init(const FreeSpaceGridConfig& config);
+
+  /// `points` and `sensor` in the map frame; `floor_z` is the floor's height there.
+  void Integrate(const Eigen::Vector3f& sensor, std::span<const Eigen::Vector3f> points, float floor_z);
+
+  Cell state(int x, int y) const;
+  bool ToCell(const Eigen::Vector2d& p, int& x, int& y) const;
+  Eigen::Vector2d CellCentre(int x, int y) const;
+  int width() const { return config_.width; }
+  int height() const { return config_.height; }
+  float resolution() const { return config_.resolution_m; }
+  std::uint64_t outside() const { return outside_; }
+  void Clear();
+
+ private:
+  void Ray(int x0, int y0, int x1, int y1, bool mark_end_free);
+
+  FreeSpaceGridConfig config_;
+  std::vector<std::uint16_t> free_;
+  std::vector<std::uint16_t> occupied_;
+  std::uint64_t outside_ = 0;
+};
+
+}  // namespace msgraphs::core

@@ -1,0 +1,195 @@
+// SPDX-License-Identifier: MIT
+// Room segmentation and detection on synthetic floors: two rooms joined by a door, a room and a
+// corridor, the same building rotated by 30 degrees, degenerate input, no allocation per call.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "msgraphs/core/perception/free_space_grid.hpp"
+#include "msgraphs/core/perception/room_segmentation.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+struct Segment2 {
+  Eigen::Vector2d a, b;
+};
+
+// A floor plan as wall-face segments (the lidar sees faces), turned by `yaw` about the origin.
+struct Plan {
+  std::vector<Segment2> faces;
+  double yaw = 0;
+  Eigen::Vector2d R(const Eigen::Vector2d& p) const { return Eigen::Rotation2Dd(yaw) * p; }
+  void Face(double x1, double y1, double x2, double y2) { faces.push_back({R({x1, y1}), R({x2, y2})}); }
+};
+
+std::optional<double> Intersect(const Eigen::Vector2d& o, const Eigen::Vector2d& d, const Segment2& s) {
+  const Eigen::Vector2d e = s.b - s.a;
+  const double den = d.x() * e.y() - d.y() * e.x();
+  if (std::fabs(den) < 1e-12) return std::nullopt;
+  const Eigen::Vector2d w = s.a - o;
+  const double t = (w.x() * e.y() - w.y() * e.x()) / den;
+  const double u = (w.x() * d.y() - w.y() * d.x()) / den;
+  if (t <= 0 || u < 0 || u > 1) return std::nullopt;
+  return t;
+}
+
+// Scans from each position: 720 horizontal rays at 1 m height, plus floor points.
+void Scan(FreeSpaceGrid& grid, const Plan& plan, const std::vector<Eigen::Vector2d>& positions) {
+  std::vector<Eigen::Vector3f> points;
+  for (const Eigen::Vector2d& local : positions) {
+    const Eigen::Vector2d o = plan.R(local);
+    points.clear();
+    for (int i = 0; i < 720; ++i) {
+      const double a = i * std::numbers::pi / 360.0;
+      const Eigen::Vector2d d(std::cos(a), std::sin(a));
+      double best = 30;
+      for (const auto& s : plan.faces) {
+        if (auto t = Intersect(o, d, s); t && *t < best) best = *t;
+      }
+      const Eigen::Vector2d p = o + d * best;
+      points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 1.0f);
+      const Eigen::Vector2d f = o + d * std::min(best - 0.1, 3.0);
+      points.emplace_back(static_cast<float>(f.x()), static_cast<float>(f.y()), 0.0f);
+    }
+    grid.Integrate(Eigen::Vector3f(static_cast<float>(o.x()), static_cast<float>(o.y()), 0.8f), points, 0.0f);
+  }
+}
+
+MapWall Wall(const Plan& plan, std::uint32_t id, double x1, double y1, double x2, double y2, const Eigen::Vector2d& inward) {
+  MapWall w;
+  w.id = id;
+  w.a = plan.R({x1, y1});
+  w.b = plan.R({x2, y2});
+  w.normal = plan.R(inward);
+  w.d = -w.normal.dot(w.a);
+  return w;
+}
+
+// Two 6 x 5 m rooms side by side (x 0..6 and 6..12), a 1 m door between them at y 2..3, and a
+// 2.4 m wide corridor along y 5..7.4 with a door to each room.
+struct TwoRoomsAndCorridor {
+  Plan plan;
+  std::vector<MapWall> walls;
+  explicit TwoRoomsAndCorridor(double yaw) {
+    plan.yaw = yaw;
+    plan.Face(0, 0, 12, 0);     // south
+    plan.Face(0, 0, 0, 7.4);    // west
+    plan.Face(12, 0, 12, 7.4);  // east
+    plan.Face(0, 7.4, 12, 7.4); // north (corridor)
+    plan.Face(6, 0, 6, 2);      // middle wall, door at y 2..3
+    plan.Face(6, 3, 6, 5);
+    plan.Face(0, 5, 2, 5);      // room/corridor wall, doors at x 2..3 and 9..10
+    plan.Face(3, 5, 9, 5);
+    plan.Face(10, 5, 12, 5);
+    const Eigen::Vector2d px(1, 0), nx(-1, 0), py(0, 1), ny(0, -1);
+    walls = {Wall(plan, 0, 0, 0, 6, 0, py),      Wall(plan, 1, 0, 0, 0, 5, px),      Wall(plan, 2, 6, 0, 6, 5, nx),
+             Wall(plan, 3, 0, 5, 6, 5, ny),      Wall(plan, 4, 6, 0, 12, 0, py),     Wall(plan, 5, 6, 0, 6, 5, px),
+             Wall(plan, 6, 12, 0, 12, 5, nx),    Wall(plan, 7, 6, 5, 12, 5, ny),     Wall(plan, 8, 0, 5, 12, 5, py),
+             Wall(plan, 9, 0, 7.4, 12, 7.4, ny)};
+  }
+};
+
+class Rooms : public ::testing::TestWithParam<double> {};
+
+TEST_P(Rooms, TwoRoomsAndACorridorWithTheirTrueOrientation) {
+  const double yaw = GetParam() * std::numbers::pi / 180.0;
+  TwoRoomsAndCorridor world(yaw);
+  FreeSpaceGridConfig gc;
+  gc.width = gc.height = 400;
+  gc.origin_m = {-10, -10};
+  FreeSpaceGrid grid;
+  ASSERT_TRUE(grid.Init(gc));
+  Scan(grid, world.plan, {{1.5, 1.5}, {4.5, 3.5}, {3, 2.5}, {7.5, 1.5}, {10.5, 3.5}, {9, 2.5}, {1, 6.2}, {6, 6.2}, {11, 6.2}});
+  RoomSegmenter segmenter;
+  ASSERT_TRUE(segmenter.Init(400, 400, 64, 64));
+  BoundedVector<RoomRegion> regions(64);
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions));
+  EXPECT_EQ(regions.size(), 3u) << "two rooms and the corridor, split at the doors";
+  BoundedVector<DetectedRoom> rooms(16);
+  ASSERT_TRUE(segmenter.DetectRooms(grid, regions.span(), world.walls, {}, rooms));
+  int found_rooms = 0, found_corridors = 0;
+  const double expected_yaw = std::remainder(yaw, std::numbers::pi / 2);
+  for (const DetectedRoom& r : rooms) {
+    EXPECT_NEAR(std::remainder(r.yaw_rad - expected_yaw, std::numbers::pi / 2), 0.0, 0.02) << "orientation";
+    const Eigen::Vector2d local = Eigen::Rotation2Dd(-yaw) * r.centre;
+    if (r.kind == RoomKind::kRoom) {
+      ++found_rooms;
+      const bool left = local.x() < 6;
+      EXPECT_NEAR(local.x(), left ? 3.0 : 9.0, 0.05);
+      EXPECT_NEAR(local.y(), 2.5, 0.05);
+      EXPECT_NEAR(std::max(r.size_x_m, r.size_y_m), 6.0, 0.05);
+      EXPECT_NEAR(std::min(r.size_x_m, r.size_y_m), 5.0, 0.05);
+      for (std::int32_t w : r.walls) EXPECT_GE(w, 0);
+    } else {
+      ++found_corridors;
+      EXPECT_NEAR(local.y(), 6.2, 0.05) << "across the corridor from its walls";
+      EXPECT_NEAR(local.x(), 6.0, 0.6) << "along it from the free space";
+      EXPECT_NEAR(r.size_x_m, 2.4, 0.05);
+    }
+  }
+  EXPECT_EQ(found_rooms, 2);
+  EXPECT_EQ(found_corridors, 1);
+}
+
+INSTANTIATE_TEST_SUITE_P(Yaws, Rooms, ::testing::Values(0.0, 30.0, -20.0, 44.0));
+
+TEST(Rooms, EmptyGridsAndRoomlessInputGiveNothingAndNoCrash) {
+  FreeSpaceGridConfig gc;
+  gc.width = gc.height = 100;
+  gc.origin_m = {-5, -5};
+  FreeSpaceGrid grid;
+  ASSERT_TRUE(grid.Init(gc));
+  RoomSegmenter segmenter;
+  ASSERT_TRUE(segmenter.Init(100, 100, 8, 8));
+  BoundedVector<RoomRegion> regions(8);
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions));
+  EXPECT_EQ(regions.size(), 0u);
+  BoundedVector<DetectedRoom> rooms(8);
+  ASSERT_TRUE(segmenter.DetectRooms(grid, regions.span(), {}, {}, rooms));
+  EXPECT_EQ(rooms.size(), 0u);
+  // A sensor outside the grid: counted, ignored.
+  std::vector<Eigen::Vector3f> pts = {{1, 1, 1}, {std::nanf(""), 0, 0}};
+  grid.Integrate(Eigen::Vector3f(100, 100, 1), pts, 0);
+  EXPECT_EQ(grid.outside(), 2u);
+  // Open space without walls: a region, but no room.
+  Plan open;
+  Scan(grid, open, {{0, 0}});
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions));
+  ASSERT_TRUE(segmenter.DetectRooms(grid, regions.span(), {}, {}, rooms));
+  EXPECT_EQ(rooms.size(), 0u);
+  RoomSegmenter wrong;
+  ASSERT_TRUE(wrong.Init(50, 50, 8, 8));
+  EXPECT_EQ(wrong.Segment(grid, {}, regions).error().code, Errc::kInvalidArgument);
+  FreeSpaceGridConfig bad;
+  bad.resolution_m = 0;
+  EXPECT_EQ(grid.Init(bad).error().code, Errc::kInvalidConfig);
+}
+
+TEST(Rooms, SegmentingAndDetectingAllocateNothing) {
+  TwoRoomsAndCorridor world(0.3);
+  FreeSpaceGridConfig gc;
+  gc.width = gc.height = 400;
+  gc.origin_m = {-10, -10};
+  FreeSpaceGrid grid;
+  ASSERT_TRUE(grid.Init(gc));
+  Scan(grid, world.plan, {{1.5, 1.5}, {7.5, 1.5}, {6, 6.2}});
+  RoomSegmenter segmenter;
+  ASSERT_TRUE(segmenter.Init(400, 400, 64, 64));
+  BoundedVector<RoomRegion> regions(64);
+  BoundedVector<DetectedRoom> rooms(16);
+  std::vector<Eigen::Vector3f> points(720, Eigen::Vector3f(1, 1, 1));
+  test::AllocationScope scope;
+  grid.Integrate(Eigen::Vector3f(0, 0, 0.8f), points, 0.0f);
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions));
+  ASSERT_TRUE(segmenter.DetectRooms(grid, regions.span(), world.walls, {}, rooms));
+  EXPECT_EQ(scope.allocations(), 0u);
+}
+
+}  // namespace
+}  // namespace msgraphs::core
