@@ -289,8 +289,8 @@ Status RoomSegmenter::DetectRooms(const FreeSpaceGrid& grid, std::span<const Roo
       const Eigen::Vector2d lengthwise = has_x ? ey : ex;
       const double mid = has_x ? mx : my;
       room.centre = mid * across + c.dot(lengthwise) * lengthwise;
+      // For a corridor the x axis points across it, so the yaw keeps its quarter turn.
       room.yaw_rad = has_x ? yaw : yaw + std::numbers::pi / 2;
-      if (room.yaw_rad >= std::numbers::pi / 4) room.yaw_rad -= std::numbers::pi / 2;
       room.size_x_m = has_x ? wx : wy;
       room.size_y_m = 0;
       room.walls = has_x ? std::array<std::int32_t, 4>{best[0], best[1], -1, -1}

@@ -51,8 +51,9 @@ struct DetectedRoom {
   RoomKind kind = RoomKind::kRoom;
   std::uint16_t region = 0;
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  /// Direction of the room frame's x axis, in [-pi/4, pi/4): rooms are symmetric under quarter
-  /// turns, so this is the orientation modulo 90 degrees.
+  /// Direction of the room frame's x axis. Rooms: in [-pi/4, pi/4), the orientation modulo 90
+  /// degrees (a rectangle is symmetric under quarter turns). Corridors: in [-pi/4, 3 pi/4), the
+  /// x axis pointing across the corridor (from its low-x wall to its high-x wall).
   double yaw_rad = 0;
   double size_x_m = 0, size_y_m = 0;  ///< wall-to-wall distances; a corridor's size_y is its length
   /// Indices into the walls given: low x, high x, low y, high y (room frame); -1 where absent
