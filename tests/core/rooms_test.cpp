@@ -139,6 +139,45 @@ TEST_P(Rooms, TwoRoomsAndACorridorWithTheirTrueOrientation) {
 
 INSTANTIATE_TEST_SUITE_P(Yaws, Rooms, ::testing::Values(0.0, 30.0, -20.0, 44.0));
 
+TEST(Rooms, AWideOpeningBetweenCollinearWallPiecesStillSeparatesRooms) {
+  // Two 8 x 6 m halls joined by a 2 m opening (x = 8, y 2..4): wider than the door cut.
+  Plan plan;
+  plan.Face(0, 0, 16, 0);
+  plan.Face(0, 6, 16, 6);
+  plan.Face(0, 0, 0, 6);
+  plan.Face(16, 0, 16, 6);
+  plan.Face(8, 0, 8, 2);
+  plan.Face(8, 4, 8, 6);
+  const Eigen::Vector2d px(1, 0), nx(-1, 0), py(0, 1), ny(0, -1);
+  // The middle wall seen from the west hall: two collinear pieces with the opening between.
+  std::vector<MapWall> walls = {Wall(plan, 0, 0, 0, 8, 0, py),   Wall(plan, 1, 0, 6, 8, 6, ny),
+                                Wall(plan, 2, 0, 0, 0, 6, px),   Wall(plan, 3, 8, 0, 8, 2, nx),
+                                Wall(plan, 4, 8, 4, 8, 6, nx),   Wall(plan, 5, 8, 0, 16, 0, py),
+                                Wall(plan, 6, 8, 6, 16, 6, ny),  Wall(plan, 7, 16, 0, 16, 6, nx),
+                                Wall(plan, 8, 8, 0, 8, 2, px),   Wall(plan, 9, 8, 4, 8, 6, px)};
+  FreeSpaceGridConfig gc;
+  gc.width = gc.height = 300;
+  gc.origin_m = {-5, -10};
+  FreeSpaceGrid grid;
+  ASSERT_TRUE(grid.Init(gc));
+  Scan(grid, plan, {{2, 2}, {6, 4}, {4, 3}, {10, 2}, {14, 4}, {12, 3}, {8, 3}});
+  RoomSegmenter segmenter;
+  ASSERT_TRUE(segmenter.Init(300, 300, 16, 16));
+  BoundedVector<RoomRegion> regions(16);
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions));
+  EXPECT_EQ(regions.size(), 1u) << "without walls the opening joins the halls";
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions, walls));
+  EXPECT_EQ(regions.size(), 2u) << "the opening between collinear pieces is closed";
+  BoundedVector<DetectedRoom> rooms(8);
+  ASSERT_TRUE(segmenter.DetectRooms(grid, regions.span(), walls, {}, rooms));
+  ASSERT_EQ(rooms.size(), 2u);
+  for (const auto& r : rooms) {
+    EXPECT_EQ(r.kind, RoomKind::kRoom);
+    EXPECT_NEAR(r.centre.y(), 3.0, 0.05);
+    EXPECT_NEAR(std::fabs(r.centre.x() - 8.0), 4.0, 0.05);
+  }
+}
+
 TEST(Rooms, EmptyGridsAndRoomlessInputGiveNothingAndNoCrash) {
   FreeSpaceGridConfig gc;
   gc.width = gc.height = 100;

@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
   if (!segmenter.Init(grid.width(), grid.height(), 1024, std::max<std::size_t>(map_walls.size(), 1))) return 1;
   BoundedVector<core::RoomRegion> regions(1024);
   BoundedVector<core::DetectedRoom> rooms(256);
-  static_cast<void>(segmenter.Segment(grid, {}, regions));
+  static_cast<void>(segmenter.Segment(grid, {}, regions, map_walls));
   static_cast<void>(segmenter.DetectRooms(grid, regions.span(), map_walls, {}, rooms));
 
   // Compare with the truth: a detection matches the true room its centre lies in.

@@ -12,7 +12,7 @@ constexpr float kInf = 1e20f;
 }  // namespace
 
 Status RoomSegmentationConfig::Validate() const {
-  if (!(door_cut_clearance_m > 0.05f) || !(min_region_area_m2 >= 0)) return Error{Errc::kInvalidConfig, "rooms: door cut clearance > 0.05 m"};
+  if (!(door_cut_clearance_m > 0.05f) || !(min_region_area_m2 >= 0) || !(close_openings_up_to_m >= 0)) return Error{Errc::kInvalidConfig, "rooms: door cut clearance > 0.05 m"};
   return Ok();
 }
 
@@ -43,6 +43,7 @@ Status RoomSegmenter::Init(int width, int height, std::size_t max_regions, std::
   max_walls_ = max_walls;
   support_.assign(max_walls * (max_regions + 1), 0);
   keep_.assign(65536, 0);
+  blocked_.assign(n, 0);
   return Ok();
 }
 
@@ -83,15 +84,54 @@ void RoomSegmenter::DistanceTransform1D(int n) {
   }
 }
 
+void RoomSegmenter::CloseOpenings(const FreeSpaceGrid& grid, std::span<const MapWall> walls, float max_gap_m) {
+  std::fill(blocked_.begin(), blocked_.end(), 0);
+  if (!(max_gap_m > 0.0f)) return;
+  const double cos5 = std::cos(5.0 * std::numbers::pi / 180.0);
+  for (std::size_t i = 0; i < walls.size(); ++i) {
+    for (std::size_t j = i + 1; j < walls.size(); ++j) {
+      const MapWall& a = walls[i];
+      const MapWall& b = walls[j];
+      if (a.normal.dot(b.normal) < cos5 || std::fabs(a.d - b.d) > 0.15) continue;  // not one line, one side
+      const Eigen::Vector2d dir(-a.normal.y(), a.normal.x());
+      double a0 = dir.dot(a.a), a1 = dir.dot(a.b), b0 = dir.dot(b.a), b1 = dir.dot(b.b);
+      if (a0 > a1) std::swap(a0, a1);
+      if (b0 > b1) std::swap(b0, b1);
+      double from = 0, to = 0;
+      if (a1 <= b0) {
+        from = a1;
+        to = b0;
+      } else if (b1 <= a0) {
+        from = b1;
+        to = a0;
+      } else {
+        continue;  // overlapping pieces: no opening between them
+      }
+      if (to - from < 0.3 || to - from > static_cast<double>(max_gap_m)) continue;
+      // Close the gap along the (averaged) line.
+      const Eigen::Vector2d foot = -0.5 * (a.d + b.d) * a.normal;
+      const double step = 0.5 * static_cast<double>(grid.resolution());
+      for (double s = from; s <= to; s += step) {
+        int x = 0, y = 0;
+        if (grid.ToCell(foot + (s - dir.dot(foot)) * dir, x, y)) blocked_[Index(x, y)] = 1;
+      }
+    }
+  }
+}
+
 Status RoomSegmenter::Segment(const FreeSpaceGrid& grid, const RoomSegmentationConfig& config,
-                              BoundedVector<RoomRegion>& regions) {
+                              BoundedVector<RoomRegion>& regions, std::span<const MapWall> walls) {
   regions.clear();
   if (Status s = config.Validate(); !s) return s;
   if (grid.width() != width_ || grid.height() != height_) return Error{Errc::kInvalidArgument, "rooms: grid size differs from Init"};
   resolution_ = grid.resolution();
-  // Distance transform: sites are the cells that are not free.
+  CloseOpenings(grid, walls, config.close_openings_up_to_m);
+  // Distance transform: sites are the cells that are not free, and closed openings.
   for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) dist2_[Index(x, y)] = grid.state(x, y) == FreeSpaceGrid::Cell::kFree ? kInf : 0.0f;
+    for (int x = 0; x < width_; ++x) {
+      const bool free = grid.state(x, y) == FreeSpaceGrid::Cell::kFree && blocked_[Index(x, y)] == 0;
+      dist2_[Index(x, y)] = free ? kInf : 0.0f;
+    }
   }
   for (int x = 0; x < width_; ++x) {
     for (int y = 0; y < height_; ++y) f_[static_cast<std::size_t>(y)] = dist2_[Index(x, y)];

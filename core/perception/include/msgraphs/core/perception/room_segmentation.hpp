@@ -26,6 +26,10 @@ struct RoomSegmentationConfig {
   /// passages up to twice as wide, doors, separate regions; cores are grown back over them.
   float door_cut_clearance_m = 0.8f;
   float min_region_area_m2 = 1.5f;
+  /// A gap of up to this width between two collinear pieces of a wall is an opening (a door, an
+  /// open doorway) and is closed before segmenting, so that rooms joined by openings wider than
+  /// the door cut still separate. 0 disables.
+  float close_openings_up_to_m = 2.5f;
   Status Validate() const;
 };
 
@@ -75,9 +79,11 @@ class RoomSegmenter {
  public:
   Status Init(int width, int height, std::size_t max_regions, std::size_t max_walls);
 
-  /// Labels the grid's regions; fills `regions` (cleared first). kCapacityExceeded (regions
-  /// kept so far) when more regions than `max_regions` exist.
-  Status Segment(const FreeSpaceGrid& grid, const RoomSegmentationConfig& config, BoundedVector<RoomRegion>& regions);
+  /// Labels the grid's regions; fills `regions` (cleared first). `walls` (optional) close the
+  /// openings between their collinear pieces. kCapacityExceeded (regions kept so far) when more
+  /// regions than `max_regions` exist.
+  Status Segment(const FreeSpaceGrid& grid, const RoomSegmentationConfig& config, BoundedVector<RoomRegion>& regions,
+                 std::span<const MapWall> walls = {});
 
   /// Rooms and corridors from the regions of the last Segment and the map's walls.
   Status DetectRooms(const FreeSpaceGrid& grid, std::span<const RoomRegion> regions, std::span<const MapWall> walls,
@@ -92,6 +98,7 @@ class RoomSegmenter {
     return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
   }
   void DistanceTransform1D(int n);
+  void CloseOpenings(const FreeSpaceGrid& grid, std::span<const MapWall> walls, float max_gap_m);
 
   int width_ = 0, height_ = 0;
   float resolution_ = 0.1f;
@@ -102,6 +109,7 @@ class RoomSegmenter {
   std::vector<int> v_;
   std::vector<std::uint32_t> support_;  // walls x regions cell counts
   std::vector<std::uint8_t> keep_;      // per label: region kept
+  std::vector<std::uint8_t> blocked_;   // openings closed for segmentation
   std::size_t max_regions_ = 0, max_walls_ = 0;
 };
 
