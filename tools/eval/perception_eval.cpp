@@ -304,6 +304,12 @@ int main(int argc, char** argv) {
     std::printf("world %s: %zu keyframes, %zu vertical planes, %zu merged walls, %zu regions, %zu rooms/corridors detected\n",
                 world->name.c_str(), keyframes, vertical_planes, map_walls.size(), regions.size(), rooms.size());
     std::printf("%s", details.str().c_str());
+    if (std::getenv("MSGRAPHS_EVAL_WALLS") != nullptr) {
+      for (const auto& w : map_walls) {
+        std::printf("  wall %u: n (%.2f, %.2f) d %.2f from (%.2f, %.2f) to (%.2f, %.2f)\n", w.id, w.normal.x(), w.normal.y(), w.d,
+                    w.a.x(), w.a.y(), w.b.x(), w.b.y());
+      }
+    }
     std::printf("precision %.2f (%zu of %zu detections are true rooms; %zu rooms found by one wall pair only), recall %.2f (%zu of %zu observed rooms)\n",
                 precision, true_positive, rooms.size(), as_corridor, recall, observed_found, observed);
     std::printf("centre error mean %.3f m, max %.3f m; orientation error mean %.2f deg, max %.2f deg\n",

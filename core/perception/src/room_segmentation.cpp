@@ -86,6 +86,19 @@ void RoomSegmenter::DistanceTransform1D(int n) {
 
 void RoomSegmenter::CloseOpenings(const FreeSpaceGrid& grid, std::span<const MapWall> walls, float max_gap_m) {
   std::fill(blocked_.begin(), blocked_.end(), 0);
+  const double step = 0.5 * static_cast<double>(grid.resolution());
+  auto block = [&](const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+    const double length = (q - p).norm();
+    for (double s = 0; s <= length; s += step) {
+      int x = 0, y = 0;
+      if (grid.ToCell(p + (q - p) * (length > 0 ? s / length : 0.0), x, y)) blocked_[Index(x, y)] = 1;
+    }
+  };
+  // A wall's extent spans its doorways when the wall continues above them (a lintel is part of
+  // the same plane): where that line crosses free space at walking height is an opening.
+  for (const MapWall& w : walls) {
+    if (w.a.allFinite() && w.b.allFinite()) block(w.a, w.b);
+  }
   if (!(max_gap_m > 0.0f)) return;
   const double cos5 = std::cos(5.0 * std::numbers::pi / 180.0);
   for (std::size_t i = 0; i < walls.size(); ++i) {
@@ -110,11 +123,7 @@ void RoomSegmenter::CloseOpenings(const FreeSpaceGrid& grid, std::span<const Map
       if (to - from < 0.3 || to - from > static_cast<double>(max_gap_m)) continue;
       // Close the gap along the (averaged) line.
       const Eigen::Vector2d foot = -0.5 * (a.d + b.d) * a.normal;
-      const double step = 0.5 * static_cast<double>(grid.resolution());
-      for (double s = from; s <= to; s += step) {
-        int x = 0, y = 0;
-        if (grid.ToCell(foot + (s - dir.dot(foot)) * dir, x, y)) blocked_[Index(x, y)] = 1;
-      }
+      block(foot + (from - dir.dot(foot)) * dir, foot + (to - dir.dot(foot)) * dir);
     }
   }
 }

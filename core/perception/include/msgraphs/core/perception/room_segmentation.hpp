@@ -28,8 +28,10 @@ struct RoomSegmentationConfig {
   float min_region_area_m2 = 1.5f;
   /// A gap of up to this width between two collinear pieces of a wall is an opening (a door, an
   /// open doorway) and is closed before segmenting, so that rooms joined by openings wider than
-  /// the door cut still separate. 0 disables.
-  float close_openings_up_to_m = 2.5f;
+  /// the door cut still separate. Kept below common corridor widths (2.4 m): partition walls
+  /// aligned across a corridor are collinear too, and closing them would cut the corridor.
+  /// 0 disables.
+  float close_openings_up_to_m = 2.2f;
   Status Validate() const;
 };
 
@@ -79,9 +81,10 @@ class RoomSegmenter {
  public:
   Status Init(int width, int height, std::size_t max_regions, std::size_t max_walls);
 
-  /// Labels the grid's regions; fills `regions` (cleared first). `walls` (optional) close the
-  /// openings between their collinear pieces. kCapacityExceeded (regions kept so far) when more
-  /// regions than `max_regions` exist.
+  /// Labels the grid's regions; fills `regions` (cleared first). `walls` (optional) close
+  /// openings: a wall's extent is blocked where it crosses free space (a doorway under a lintel
+  /// of the same plane), and so are gaps between collinear wall pieces (see the config).
+  /// kCapacityExceeded (regions kept so far) when more regions than `max_regions` exist.
   Status Segment(const FreeSpaceGrid& grid, const RoomSegmentationConfig& config, BoundedVector<RoomRegion>& regions,
                  std::span<const MapWall> walls = {});
 
