@@ -42,6 +42,9 @@ class ScanContext {
   float ring_key(int ring) const { return ring_key_[static_cast<std::size_t>(ring)]; }
   float sector_key(int sector) const { return sector_key_[static_cast<std::size_t>(sector)]; }
   float column_norm(int sector) const { return column_norm_[static_cast<std::size_t>(sector)]; }
+  /// Column `sector` divided by its norm, rings contiguous (zero for an empty column): the
+  /// distance is then one contiguous dot product per column pair.
+  const float* unit_column(int sector) const { return &unit_columns_[static_cast<std::size_t>(sector * kMaxRings)]; }
   std::size_t points_used() const { return points_used_; }
   float max_radius_m() const { return max_radius_; }
 
@@ -59,6 +62,7 @@ class ScanContext {
   std::array<float, kMaxRings> ring_key_{};
   std::array<float, kMaxSectors> sector_key_{};
   std::array<float, kMaxSectors> column_norm_{};
+  std::array<float, kMaxSectors * kMaxRings> unit_columns_{};
 };
 
 struct ScanContextMatch {
