@@ -16,8 +16,11 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
+#include "msgraphs/core/descriptors/scan_context.hpp"
 #include "msgraphs/core/perception/covariances.hpp"
 #include "msgraphs/core/perception/deskew.hpp"
 #include "msgraphs/core/perception/free_space_grid.hpp"
@@ -157,6 +160,11 @@ int main(int argc, char** argv) {
   if (!grid.Init(grid_config)) return 1;
   std::vector<MergedWall> walls;
   std::size_t keyframes = 0, vertical_planes = 0;
+  // Room-centred clouds per (robot, true room), deduplicated on a 0.1 m voxel key, for the
+  // Scan Context evaluation: the room frame is the true room's rectangle.
+  std::vector<sim::RoomRectangle> rects;
+  for (const auto& room : world->rooms) rects.push_back(sim::MinAreaRectangle(room));
+  std::map<std::pair<int, std::size_t>, std::unordered_set<std::uint64_t>> room_voxels;
   double plane_ms = 0;
 
   for (int robot = 1; robot <= 10; ++robot) {
@@ -213,6 +221,14 @@ int main(int argc, char** argv) {
       world_points.clear();
       for (const auto& p : filtered) static_cast<void>(world_points.try_push_back((T_world_end * p.cast<double>()).cast<float>()));
       grid.Integrate(T_world_end.translation().cast<float>(), world_points.span(), 0.0f);
+      for (const auto& p : down) {
+        const Eigen::Vector3d q = T_world_end * p.cast<double>();
+        const sim::Room* room = world->RoomAt(q.head<2>(), 0);
+        if (room == nullptr || q.z() < 0.05 || q.z() > 2.9) continue;  // walls and furniture, not floor or ceiling
+        std::uint64_t key = 0;
+        if (!core::VoxelKey(q.cast<float>(), 10.0f, key)) continue;
+        room_voxels[{robot, static_cast<std::size_t>(room - world->rooms.data())}].insert(key);
+      }
       // Walls into the world frame, as 2-D lines with their extent.
       for (const auto& plane : planes) {
         if (plane.kind != core::PlaneKind::kVertical) continue;
@@ -291,6 +307,61 @@ int main(int argc, char** argv) {
       observed_found += matched[room.id] ? 1u : 0u;
     }
   }
+  // Scan Context between robots: each robot's cloud of a room, in that room's frame (z above the
+  // floor), against every other robot's rooms. Same room should be nearest.
+  struct Descriptor {
+    int robot;
+    std::size_t room;
+    core::ScanContext sc;
+  };
+  std::vector<Descriptor> descriptors;
+  for (const auto& [key, voxels] : room_voxels) {
+    if (voxels.size() < 500) continue;  // barely seen
+    const sim::RoomRectangle& rect = rects[key.second];
+    const double yaw = rect.orientation_deg * std::numbers::pi / 180.0;
+    const Eigen::Rotation2Dd to_room(-yaw);
+    std::vector<Eigen::Vector3f> cloud;
+    for (std::uint64_t v : voxels) {
+      Eigen::Vector3d q;
+      for (int a = 0; a < 3; ++a) q[a] = (static_cast<double>((v >> (21 * a)) & 0x1FFFFF) - (1 << 20) + 0.5) * 0.1;
+      const Eigen::Vector2d xy = to_room * (q.head<2>() - rect.centre);
+      cloud.emplace_back(static_cast<float>(xy.x()), static_cast<float>(xy.y()), static_cast<float>(q.z()));
+    }
+    const core::ScanContextConfig sc_config;  // one absolute scale (12 m) for every room
+    core::ScanContext sc;
+    if (!sc.Build(cloud, sc_config)) continue;
+    descriptors.push_back({key.first, key.second, sc});
+  }
+  std::size_t sc_queries = 0, sc_top1 = 0, sc_below = 0, sc_false_below = 0;
+  double same_sum = 0, other_sum = 0;
+  std::size_t same_n = 0, other_n = 0;
+  for (const Descriptor& q : descriptors) {
+    float best = 2.0f;
+    std::size_t best_room = 0;
+    bool has_same = false;
+    for (const Descriptor& o : descriptors) {
+      if (o.robot == q.robot) continue;
+      const auto m = core::ScanContextDistance(q.sc, o.sc);
+      if (!m) continue;
+      if (o.room == q.room) {
+        has_same = true;
+        same_sum += static_cast<double>(m->distance);
+        ++same_n;
+        if (m->distance < 0.35f) ++sc_below;
+      } else {
+        other_sum += static_cast<double>(m->distance);
+        ++other_n;
+        if (m->distance < 0.35f) ++sc_false_below;
+      }
+      if (m->distance < best) {
+        best = m->distance;
+        best_room = o.room;
+      }
+    }
+    if (!has_same) continue;
+    ++sc_queries;
+    if (best_room == q.room) ++sc_top1;
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   const double precision = rooms.empty() ? 0.0 : static_cast<double>(true_positive) / static_cast<double>(rooms.size());
   const double recall = observed == 0 ? 0.0 : static_cast<double>(observed_found) / static_cast<double>(observed);
@@ -314,6 +385,10 @@ int main(int argc, char** argv) {
                 precision, true_positive, rooms.size(), as_corridor, recall, observed_found, observed);
     std::printf("centre error mean %.3f m, max %.3f m; orientation error mean %.2f deg, max %.2f deg\n",
                 centre_error_sum / n, centre_error_max, yaw_error_sum / n, yaw_error_max);
+    std::printf("scan context across robots: %zu room descriptors; same room mean distance %.3f (%zu pairs, %zu below SC_th 0.35), "
+                "different rooms %.3f (%zu pairs, %zu below 0.35); nearest is the same room for %zu of %zu\n",
+                descriptors.size(), same_sum / std::max<double>(1.0, static_cast<double>(same_n)), same_n, sc_below,
+                other_sum / std::max<double>(1.0, static_cast<double>(other_n)), other_n, sc_false_below, sc_top1, sc_queries);
     std::printf("wall extraction %.1f ms per keyframe; total %.1f s\n", plane_ms / std::max<double>(1, static_cast<double>(keyframes)), seconds);
   }
   return 0;
