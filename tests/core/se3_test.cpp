@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/geometry/se3.hpp"
+#include "msgraphs/core/geometry/umeyama.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace msgraphs::core {
 namespace {
@@ -64,6 +66,29 @@ TEST(Se3, RejectsInvalidTransforms) {
   T = Eigen::Isometry3d::Identity();
   T.linear() *= 1.01;  // scaled
   EXPECT_FALSE(IsValidRigidTransform(T));
+}
+
+}  // namespace
+}  // namespace msgraphs::core
+
+
+namespace msgraphs::core {
+namespace {
+
+TEST(Umeyama, RecoversARigidTransformAndRefusesDegenerateSets) {
+  const Eigen::Isometry3d truth = Eigen::Translation3d(1, -2, 0.5) * Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
+  std::vector<Eigen::Vector3d> a, b;
+  for (int i = 0; i < 20; ++i) {
+    a.emplace_back(std::sin(i), std::cos(3.0 * i), 0.1 * i);
+    b.push_back(truth * a.back());
+  }
+  const auto T = AlignUmeyama(a, b);
+  ASSERT_TRUE(T.has_value());
+  EXPECT_LT((T->matrix() - truth.matrix()).norm(), 1e-9);
+  std::vector<Eigen::Vector3d> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  EXPECT_EQ(AlignUmeyama(line, line).error().code, Errc::kDegenerate);
+  EXPECT_EQ(AlignUmeyama(std::span(a).first(2), std::span(b).first(2)).error().code, Errc::kDegenerate);
+  EXPECT_EQ(AlignUmeyama(a, std::span(b).first(5)).error().code, Errc::kInvalidArgument);
 }
 
 }  // namespace
