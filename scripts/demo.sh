@@ -21,4 +21,5 @@ echo "=== 2. three robots (three msgraphs_node processes) discover each other ov
 tests/runtime/heartbeat_processes_test.sh "$node" 3 91
 echo
 echo "What this shows: the build, the platform layer and the DDS link between real processes."
-echo "The SLAM pipeline (drivers, S-Graphs, room matching) is not built yet: see 'issues'."
+echo "Built and tested but not yet joined into the node: drivers, simulator, perception, pose graphs (docs/)."
+echo "The S-Graph, room matching and the multi-robot demo are still open: see 'issues'."
