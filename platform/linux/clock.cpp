@@ -40,4 +40,10 @@ void SleepUntil(SteadyTime deadline) noexcept {
   }
 }
 
+timespec RemainingUntil(SteadyTime deadline) noexcept {
+  std::int64_t ns = (deadline - SteadyNow()).nanoseconds();
+  if (ns < 0) ns = 0;
+  return timespec{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+}
+
 }  // namespace msgraphs::platform

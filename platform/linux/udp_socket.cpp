@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "msgraphs/platform/clock.hpp"
+#include "msgraphs/platform/receive_metadata.hpp"
 
 namespace msgraphs::platform {
 namespace {
@@ -24,22 +25,13 @@ sockaddr_in ToSockaddr(const Ipv4Endpoint& endpoint) {
   return a;
 }
 
-// Room for SO_TIMESTAMPNS (a timespec) and SO_RXQ_OVFL (a uint32) control messages.
-constexpr std::size_t kControlBytes = CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t));
-
-timespec ToTimeout(SteadyTime deadline) {
-  std::int64_t ns = (deadline - SteadyNow()).nanoseconds();
-  if (ns < 0) ns = 0;
-  return timespec{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
-}
-
 }  // namespace
 
 // ---- receiver --------------------------------------------------------------------------------
 
 struct UdpReceiver::Buffers {
   std::vector<std::uint8_t> payload;  // batch x (max_payload_bytes + 1)
-  std::vector<std::uint8_t> control;  // batch x kControlBytes
+  std::vector<std::uint8_t> control;  // batch x kReceiveControlBytes
   std::vector<mmsghdr> headers;
   std::vector<iovec> iov;
   std::vector<sockaddr_in> sources;
@@ -101,7 +93,7 @@ UdpReceiver::UdpReceiver(int fd, const UdpReceiverConfig& config)
   const std::size_t slot = config.max_payload_bytes + 1;  // +1 detects truncation via MSG_TRUNC too
   Buffers& b = *buffers_;
   b.payload.resize(config.batch * slot);
-  b.control.resize(config.batch * kControlBytes);
+  b.control.resize(config.batch * kReceiveControlBytes);
   b.headers.resize(config.batch);
   b.iov.resize(config.batch);
   b.sources.resize(config.batch);
@@ -139,8 +131,8 @@ std::size_t UdpReceiver::ReceiveBatch(int& error_out) {
     h.msg_namelen = sizeof(sockaddr_in);
     h.msg_iov = &b.iov[i];
     h.msg_iovlen = 1;
-    h.msg_control = b.control.data() + i * kControlBytes;
-    h.msg_controllen = kControlBytes;
+    h.msg_control = b.control.data() + i * kReceiveControlBytes;
+    h.msg_controllen = kReceiveControlBytes;
     b.headers[i].msg_len = 0;
   }
   ++stats_.receive_calls;
@@ -156,20 +148,8 @@ std::size_t UdpReceiver::ReceiveBatch(int& error_out) {
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const msghdr& h = b.headers[k].msg_hdr;
-    timespec stamp{};
-    for (cmsghdr* c = CMSG_FIRSTHDR(const_cast<msghdr*>(&h)); c != nullptr;
-         c = CMSG_NXTHDR(const_cast<msghdr*>(&h), c)) {
-      if (c->cmsg_level != SOL_SOCKET) continue;
-      if (c->cmsg_type == SO_TIMESTAMPNS) {
-        std::memcpy(&stamp, CMSG_DATA(c), sizeof(stamp));
-      } else if (c->cmsg_type == SO_RXQ_OVFL) {
-        std::uint32_t dropped = 0;
-        std::memcpy(&dropped, CMSG_DATA(c), sizeof(dropped));
-        // Cumulative per socket, wrapping at 2^32: add the increment.
-        stats_.kernel_drops += static_cast<std::uint32_t>(dropped - last_overflow_count_);
-        last_overflow_count_ = dropped;
-      }
-    }
+    const ReceiveMetadata meta = ParseReceiveMetadata(h);
+    AccumulateDrops(meta, last_overflow_count_, stats_.kernel_drops);
     const std::size_t length = b.headers[k].msg_len;
     if ((h.msg_flags & MSG_TRUNC) != 0 || length > config_.max_payload_bytes) {
       ++stats_.truncated;
@@ -183,10 +163,7 @@ std::size_t UdpReceiver::ReceiveBatch(int& error_out) {
       continue;
     }
     ReceivedDatagram& d = b.accepted[accepted++];
-    d.kernel_time = stats_.kernel_timestamps
-                        ? UnixTime::FromNanoseconds(static_cast<std::int64_t>(stamp.tv_sec) * 1'000'000'000 +
-                                                    stamp.tv_nsec)
-                        : now;
+    d.kernel_time = stats_.kernel_timestamps && meta.has_time ? meta.time : now;
     d.source = {source_address, ntohs(from.sin_port)};
     d.payload = {b.payload.data() + k * slot, length};
     ++stats_.datagrams;
@@ -210,11 +187,10 @@ Expected<std::size_t> UdpReceiver::Receive(SteadyTime deadline) {
     }
     if (error == 0) continue;  // a batch of only rejected datagrams: look again at once
     if (SteadyNow() >= deadline) return std::size_t{0};
-    pollfd p{fd_, POLLIN, 0};
-    const timespec timeout = ToTimeout(deadline);
-    const int rc = ::ppoll(&p, 1, &timeout, nullptr);
-    if (rc < 0 && errno != EINTR) return Error{Errc::kIo, "udp: ppoll failed", errno};
-    if (rc == 0) return std::size_t{0};
+    const int fds[1] = {fd_};
+    auto ready = WaitReadable(fds, deadline);
+    if (!ready) return ready.error();
+    if (*ready == 0) return std::size_t{0};
   }
 }
 
@@ -223,7 +199,7 @@ Expected<std::uint32_t> WaitReadable(std::span<const int> fds, SteadyTime deadli
   pollfd p[32];
   for (std::size_t i = 0; i < fds.size(); ++i) p[i] = pollfd{fds[i], POLLIN, 0};
   for (;;) {
-    const timespec timeout = ToTimeout(deadline);
+    const timespec timeout = RemainingUntil(deadline);
     const int rc = ::ppoll(p, fds.size(), &timeout, nullptr);
     if (rc < 0) {
       if (errno == EINTR) continue;

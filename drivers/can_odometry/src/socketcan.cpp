@@ -16,11 +16,11 @@
 
 #include "msgraphs/drivers/can_odometry/odometry_frames.hpp"
 #include "msgraphs/platform/clock.hpp"
+#include "msgraphs/platform/receive_metadata.hpp"
+#include "msgraphs/platform/udp_socket.hpp"
 
 namespace msgraphs::drivers::can_odometry {
 namespace {
-
-constexpr std::size_t kControlBytes = CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t));
 
 Expected<int> OpenBound(std::string_view interface) {
   if (interface.empty() || interface.size() >= IFNAMSIZ) {
@@ -122,7 +122,7 @@ Expected<SocketCanSource> SocketCanSource::Open(const SocketCanConfig& config) {
 SocketCanSource::SocketCanSource(int fd, std::size_t batch)
     : fd_(fd), batch_(batch), buffers_(std::make_unique<Buffers>()) {
   buffers_->frames.resize(batch);
-  buffers_->control.resize(batch * kControlBytes);
+  buffers_->control.resize(batch * platform::kReceiveControlBytes);
   buffers_->headers.resize(batch);
   buffers_->iov.resize(batch);
   buffers_->ready.resize(batch);
@@ -157,8 +157,8 @@ Expected<std::size_t> SocketCanSource::Receive(SteadyTime deadline) {
       h = msghdr{};
       h.msg_iov = &b.iov[i];
       h.msg_iovlen = 1;
-      h.msg_control = b.control.data() + i * kControlBytes;
-      h.msg_controllen = kControlBytes;
+      h.msg_control = b.control.data() + i * platform::kReceiveControlBytes;
+      h.msg_controllen = platform::kReceiveControlBytes;
     }
     const int n = ::recvmmsg(fd_, b.headers.data(), static_cast<unsigned>(batch_), MSG_DONTWAIT, nullptr);
     if (n < 0) {
@@ -166,30 +166,16 @@ Expected<std::size_t> SocketCanSource::Receive(SteadyTime deadline) {
         return Error{Errc::kIo, "socketcan: recvmmsg failed", errno};
       }
       if (platform::SteadyNow() >= deadline) return std::size_t{0};
-      std::int64_t ns = (deadline - platform::SteadyNow()).nanoseconds();
-      if (ns < 0) ns = 0;
-      const timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
-      pollfd p{fd_, POLLIN, 0};
-      const int rc = ::ppoll(&p, 1, &timeout, nullptr);
-      if (rc < 0 && errno != EINTR) return Error{Errc::kIo, "socketcan: ppoll failed", errno};
-      if (rc == 0) return std::size_t{0};
+      const int fds[1] = {fd_};
+      auto ready = platform::WaitReadable(fds, deadline);
+      if (!ready) return ready.error();
+      if (*ready == 0) return std::size_t{0};
       continue;
     }
     for (int i = 0; i < n; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      msghdr& h = b.headers[k].msg_hdr;
-      timespec stamp{};
-      for (cmsghdr* c = CMSG_FIRSTHDR(&h); c != nullptr; c = CMSG_NXTHDR(&h, c)) {
-        if (c->cmsg_level != SOL_SOCKET) continue;
-        if (c->cmsg_type == SO_TIMESTAMPNS) {
-          std::memcpy(&stamp, CMSG_DATA(c), sizeof(stamp));
-        } else if (c->cmsg_type == SO_RXQ_OVFL) {
-          std::uint32_t dropped = 0;
-          std::memcpy(&dropped, CMSG_DATA(c), sizeof(dropped));
-          stats_.kernel_drops += static_cast<std::uint32_t>(dropped - last_overflow_);
-          last_overflow_ = dropped;
-        }
-      }
+      const platform::ReceiveMetadata meta = platform::ParseReceiveMetadata(b.headers[k].msg_hdr);
+      platform::AccumulateDrops(meta, last_overflow_, stats_.kernel_drops);
       if (b.headers[k].msg_len != sizeof(can_frame)) {
         ++stats_.fd_frames;
         continue;
@@ -201,8 +187,7 @@ Expected<std::size_t> SocketCanSource::Receive(SteadyTime deadline) {
         continue;
       }
       TimedCanFrame& out = b.ready[ready_++];
-      out.kernel_time = UnixTime::FromNanoseconds(static_cast<std::int64_t>(stamp.tv_sec) * 1'000'000'000 +
-                                                  stamp.tv_nsec);
+      out.kernel_time = meta.has_time ? meta.time : platform::UnixNow();
       out.frame = CanFrame{};
       out.frame.extended = (raw.can_id & CAN_EFF_FLAG) != 0;
       out.frame.remote = (raw.can_id & CAN_RTR_FLAG) != 0;

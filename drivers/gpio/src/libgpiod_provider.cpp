@@ -78,9 +78,7 @@ class LibgpiodInput : public EdgeInput {
   explicit LibgpiodInput(std::unique_ptr<RequestedLine> line) : line_(std::move(line)) {}
   Expected<bool> WaitEvent(SteadyTime deadline, EdgeEvent& event) override {
     for (;;) {
-      std::int64_t ns = (deadline - platform::SteadyNow()).nanoseconds();
-      if (ns < 0) ns = 0;
-      const timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+      const timespec timeout = platform::RemainingUntil(deadline);
       const int rc = gpiod_line_event_wait(line_->line(), &timeout);
       if (rc < 0) {
         if (errno == EINTR) continue;
