@@ -3,19 +3,14 @@
 
 #include <cmath>
 
+#include "msgraphs/base/byte_order.hpp"
 #include "msgraphs/drivers/can_odometry/crc8.hpp"
 
 namespace msgraphs::drivers::can_odometry {
 namespace {
 
-std::int16_t I16(const std::uint8_t* p) {
-  return static_cast<std::int16_t>(static_cast<std::uint16_t>(p[0] | (p[1] << 8)));
-}
-void PutI16(std::uint8_t* p, std::int16_t v) {
-  const auto u = static_cast<std::uint16_t>(v);
-  p[0] = static_cast<std::uint8_t>(u & 0xFFu);
-  p[1] = static_cast<std::uint8_t>(u >> 8);
-}
+std::int16_t I16(const std::uint8_t* p) { return static_cast<std::int16_t>(ReadU16Le(p)); }
+void PutI16(std::uint8_t* p, std::int16_t v) { WriteU16Le(p, static_cast<std::uint16_t>(v)); }
 std::int16_t Quantise(double value, double unit) {
   double counts = std::round(value / unit);
   if (!(counts >= -32768.0)) counts = -32768.0;  // also catches NaN
@@ -48,9 +43,7 @@ Expected<OdomFrame> DecodeOdomFrame(const CanFrame& frame) {
   out.sequence = d[6];
   if (frame.id == kSampleTimeId) {
     out.kind = OdomFrameKind::kSampleTime;
-    out.sample_time_us = static_cast<std::uint32_t>(d[0]) | (static_cast<std::uint32_t>(d[1]) << 8) |
-                         (static_cast<std::uint32_t>(d[2]) << 16) |
-                         (static_cast<std::uint32_t>(d[3]) << 24);
+    out.sample_time_us = ReadU32Le(d);
     out.status = d[4];
     return out;
   }
@@ -73,9 +66,7 @@ std::array<CanFrame, 3> EncodeOdomSample(const OdomSampleValues& s) {
   PutI16(spatial.data() + 4, Quantise(s.dpitch_rad, kRotationUnitRad));
   spatial[6] = s.sequence;
   std::array<std::uint8_t, 8> timing{};
-  for (int i = 0; i < 4; ++i) {
-    timing[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>((s.sample_time_us >> (8 * i)) & 0xFFu);
-  }
+  WriteU32Le(timing.data(), s.sample_time_us);
   timing[4] = s.status;
   timing[5] = 0;
   timing[6] = s.sequence;

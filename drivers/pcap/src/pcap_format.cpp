@@ -1,32 +1,21 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/drivers/pcap/pcap_format.hpp"
 
+#include "msgraphs/base/byte_order.hpp"
+
 namespace msgraphs::drivers::pcap {
 namespace {
 
-std::uint32_t ReadU32(const std::uint8_t* p, bool swapped) {
-  // Files are written in the writer's native order; we read little-endian and swap when the
-  // magic says the writer was big-endian (or vice versa on a big-endian reader: not supported
-  // targets, both x86 and aarch64 Linux are little-endian).
-  const std::uint32_t le = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-                           (static_cast<std::uint32_t>(p[2]) << 16) |
-                           (static_cast<std::uint32_t>(p[3]) << 24);
-  if (!swapped) return le;
-  return (le >> 24) | ((le >> 8) & 0xFF00u) | ((le << 8) & 0xFF0000u) | (le << 24);
-}
-std::uint16_t ReadU16(const std::uint8_t* p, bool swapped) {
-  return swapped ? static_cast<std::uint16_t>((p[0] << 8) | p[1])
-                 : static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
-void PutU32(std::uint8_t* p, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFu);
-}
-void PutU16(std::uint8_t* p, std::uint16_t v) {
-  p[0] = static_cast<std::uint8_t>(v & 0xFFu);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
 std::uint32_t Swap32(std::uint32_t v) {
   return (v >> 24) | ((v >> 8) & 0xFF00u) | ((v << 8) & 0xFF0000u) | (v << 24);
+}
+// Files are written in the writer's byte order; the magic number says whether it was ours.
+std::uint32_t ReadU32(const std::uint8_t* p, bool swapped) {
+  const std::uint32_t le = ReadU32Le(p);
+  return swapped ? Swap32(le) : le;
+}
+std::uint16_t ReadU16(const std::uint8_t* p, bool swapped) {
+  return swapped ? static_cast<std::uint16_t>((p[0] << 8) | p[1]) : ReadU16Le(p);
 }
 
 }  // namespace
@@ -42,7 +31,8 @@ Expected<GlobalHeader> ParseGlobalHeader(std::span<const std::uint8_t> bytes) {
   } else if (Swap32(magic) == kMagicMicroseconds || Swap32(magic) == kMagicNanoseconds) {
     h.swapped = true;
   } else if (magic == 0x0A0D0D0A) {
-    return Error{Errc::kUnsupported, "pcap: this is a pcapng file; convert it with editcap -F pcap"};
+    return Error{Errc::kUnsupported,
+                 "pcap: this is a pcapng file; convert it with editcap -F pcap"};
   } else {
     return Error{Errc::kMalformed, "pcap: bad magic number (not a libpcap file)"};
   }
@@ -84,30 +74,34 @@ Expected<RecordHeader> ParseRecordHeader(std::span<const std::uint8_t> bytes,
   return r;
 }
 
-void WriteGlobalHeader(std::span<std::uint8_t, kGlobalHeaderBytes> out, TimestampPrecision precision,
-                       std::uint32_t snaplen, LinkType link_type) {
-  PutU32(out.data(), precision == TimestampPrecision::kNanoseconds ? kMagicNanoseconds
-                                                                   : kMagicMicroseconds);
-  PutU16(out.data() + 4, 2);
-  PutU16(out.data() + 6, 4);
-  PutU32(out.data() + 8, 0);   // thiszone
-  PutU32(out.data() + 12, 0);  // sigfigs
-  PutU32(out.data() + 16, snaplen);
-  PutU32(out.data() + 20, static_cast<std::uint32_t>(link_type));
+void WriteGlobalHeader(std::span<std::uint8_t, kGlobalHeaderBytes> out,
+                       TimestampPrecision precision,
+                       std::uint32_t snaplen,
+                       LinkType link_type) {
+  WriteU32Le(out.data(), precision == TimestampPrecision::kNanoseconds ? kMagicNanoseconds
+                                                                       : kMagicMicroseconds);
+  WriteU16Le(out.data() + 4, 2);
+  WriteU16Le(out.data() + 6, 4);
+  WriteU32Le(out.data() + 8, 0);   // thiszone
+  WriteU32Le(out.data() + 12, 0);  // sigfigs
+  WriteU32Le(out.data() + 16, snaplen);
+  WriteU32Le(out.data() + 20, static_cast<std::uint32_t>(link_type));
 }
 
-void WriteRecordHeader(std::span<std::uint8_t, kRecordHeaderBytes> out, UnixTime timestamp,
-                       TimestampPrecision precision, std::uint32_t captured_bytes,
+void WriteRecordHeader(std::span<std::uint8_t, kRecordHeaderBytes> out,
+                       UnixTime timestamp,
+                       TimestampPrecision precision,
+                       std::uint32_t captured_bytes,
                        std::uint32_t original_bytes) {
   std::int64_t ns = timestamp.nanoseconds_since_epoch();
   if (ns < 0) ns = 0;  // pcap has no times before 1970
   const auto seconds = static_cast<std::uint32_t>(ns / 1'000'000'000);
   const auto sub_ns = static_cast<std::uint32_t>(ns % 1'000'000'000);
-  PutU32(out.data(), seconds);
-  PutU32(out.data() + 4,
-         precision == TimestampPrecision::kNanoseconds ? sub_ns : sub_ns / 1000u);
-  PutU32(out.data() + 8, captured_bytes);
-  PutU32(out.data() + 12, original_bytes);
+  WriteU32Le(out.data(), seconds);
+  WriteU32Le(out.data() + 4,
+             precision == TimestampPrecision::kNanoseconds ? sub_ns : sub_ns / 1000u);
+  WriteU32Le(out.data() + 8, captured_bytes);
+  WriteU32Le(out.data() + 12, original_bytes);
 }
 
 }  // namespace msgraphs::drivers::pcap

@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "msgraphs/base/byte_order.hpp"
+
 namespace msgraphs::drivers::velodyne {
 
 inline constexpr std::size_t kDataPacketBytes = 1206;
@@ -47,19 +49,10 @@ enum class ProductId : std::uint8_t {
   kVls128 = 0xA1,
 };
 
-inline std::uint16_t ReadU16Le(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
-inline std::uint32_t ReadU32Le(const std::uint8_t* p) {
-  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-}
-inline void WriteU16Le(std::uint8_t* p, std::uint16_t v) {
-  p[0] = static_cast<std::uint8_t>(v & 0xFFu);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
-inline void WriteU32Le(std::uint8_t* p, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFu);
-}
+// The format's fields are little-endian; the readers and writers are base's.
+using msgraphs::ReadU16Le;
+using msgraphs::ReadU32Le;
+using msgraphs::WriteU16Le;
+using msgraphs::WriteU32Le;
 
 }  // namespace msgraphs::drivers::velodyne
