@@ -24,12 +24,13 @@ Scene::Scene(const World& world, int level, double cell_size_m) : cell_(cell_siz
     const double yaw_c = dir.x(), yaw_s = dir.y();
     const double length = w.length();
     std::vector<Door> doors = w.doors;
-    std::sort(doors.begin(), doors.end(), [](const Door& a, const Door& b) { return a.offset_m < b.offset_m; });
+    std::sort(doors.begin(), doors.end(),
+              [](const Door& a, const Door& b) { return a.offset_m < b.offset_m; });
     auto add_piece = [&](double a, double b, double z0, double z1) {
       if (b - a < 1e-6 || z1 - z0 < 1e-6) return;
       const Eigen::Vector2d centre = w.start + dir * (0.5 * (a + b));
-      boxes_.push_back({centre, yaw_c, yaw_s, 0.5 * (b - a), 0.5 * w.thickness_m, floor_z_ + z0, floor_z_ + z1,
-                        w.material});
+      boxes_.push_back({centre, yaw_c, yaw_s, 0.5 * (b - a), 0.5 * w.thickness_m, floor_z_ + z0,
+                        floor_z_ + z1, w.material});
     };
     double cursor = -0.5 * w.thickness_m;
     for (const Door& d : doors) {
@@ -41,8 +42,8 @@ Scene::Scene(const World& world, int level, double cell_size_m) : cell_(cell_siz
   }
   for (const Box& b : world.boxes) {
     if (b.level != level) continue;
-    boxes_.push_back({b.centre, std::cos(b.yaw_rad), std::sin(b.yaw_rad), 0.5 * b.size_m.x(), 0.5 * b.size_m.y(),
-                      floor_z_, floor_z_ + b.size_m.z(), b.material});
+    boxes_.push_back({b.centre, std::cos(b.yaw_rad), std::sin(b.yaw_rad), 0.5 * b.size_m.x(),
+                      0.5 * b.size_m.y(), floor_z_, floor_z_ + b.size_m.z(), b.material});
   }
   for (const Cylinder& c : world.cylinders) {
     if (c.level != level) continue;
@@ -62,7 +63,8 @@ Scene::Scene(const World& world, int level, double cell_size_m) : cell_(cell_siz
     bounds.emplace_back(b.centre - Eigen::Vector2d(ex, ey), b.centre + Eigen::Vector2d(ex, ey));
   }
   for (const CylinderPrimitive& c : cylinders_) {
-    bounds.emplace_back(c.centre - Eigen::Vector2d(c.radius, c.radius), c.centre + Eigen::Vector2d(c.radius, c.radius));
+    bounds.emplace_back(c.centre - Eigen::Vector2d(c.radius, c.radius),
+                        c.centre + Eigen::Vector2d(c.radius, c.radius));
   }
   for (const auto& [a, b] : bounds) grow(a, b);
   for (const Room& r : world.rooms) {
@@ -76,7 +78,8 @@ Scene::Scene(const World& world, int level, double cell_size_m) : cell_(cell_siz
   nx_ = static_cast<int>(std::ceil((hi.x() - origin_.x()) / cell_)) + 1;
   ny_ = static_cast<int>(std::ceil((hi.y() - origin_.y()) / cell_)) + 1;
   building_.assign(static_cast<std::size_t>(nx_ * ny_), {});
-  for (std::uint32_t id = 0; id < bounds.size(); ++id) Insert(id, bounds[id].first, bounds[id].second);
+  for (std::uint32_t id = 0; id < bounds.size(); ++id)
+    Insert(id, bounds[id].first, bounds[id].second);
   cell_start_.assign(building_.size() + 1, 0);
   for (std::size_t k = 0; k < building_.size(); ++k) {
     cell_start_[k + 1] = cell_start_[k] + static_cast<std::uint32_t>(building_[k].size());
@@ -103,7 +106,10 @@ Scene::Scratch Scene::MakeScratch() const {
   return s;
 }
 
-bool Scene::TestPrimitive(std::uint32_t id, const Eigen::Vector3d& o, const Eigen::Vector3d& d, Hit& best) const {
+bool Scene::TestPrimitive(std::uint32_t id,
+                          const Eigen::Vector3d& o,
+                          const Eigen::Vector3d& d,
+                          Hit& best) const {
   if (id < boxes_.size()) {
     const BoxPrimitive& b = boxes_[id];
     // Into the box frame (yaw only).
@@ -129,7 +135,9 @@ bool Scene::TestPrimitive(std::uint32_t id, const Eigen::Vector3d& o, const Eige
       t_out = std::min(t_out, t1);
       return t_in <= t_out;
     };
-    if (!slab(lx, dx, -b.hx, b.hx, 0) || !slab(ly, dy, -b.hy, b.hy, 1) || !slab(o.z(), d.z(), b.z0, b.z1, 2)) return false;
+    if (!slab(lx, dx, -b.hx, b.hx, 0) || !slab(ly, dy, -b.hy, b.hy, 1) ||
+        !slab(o.z(), d.z(), b.z0, b.z1, 2))
+      return false;
     if (t_in <= 1e-6 || t_in >= best.range_m) return false;
     best.range_m = t_in;
     best.material = b.material;
@@ -170,7 +178,9 @@ bool Scene::TestPrimitive(std::uint32_t id, const Eigen::Vector3d& o, const Eige
   return hit;
 }
 
-std::optional<Hit> Scene::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_range,
+std::optional<Hit> Scene::Cast(const Eigen::Vector3d& o,
+                               const Eigen::Vector3d& d,
+                               double max_range,
                                Scratch& scratch) const {
   Hit best;
   best.range_m = max_range;
@@ -202,8 +212,10 @@ std::optional<Hit> Scene::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& 
   const double inv_dy = std::fabs(d.y()) > kEps ? 1.0 / std::fabs(d.y()) : kInf;
   // A ray without an x (or y) component never crosses an x (or y) cell boundary. Setting that
   // explicitly avoids 0 * inf = NaN when the origin lies exactly on a boundary.
-  double t_next_x = inv_dx == kInf ? kInf : ((d.x() > 0 ? (cx + 1 - gx) : (gx - cx)) * cell_) * inv_dx;
-  double t_next_y = inv_dy == kInf ? kInf : ((d.y() > 0 ? (cy + 1 - gy) : (gy - cy)) * cell_) * inv_dy;
+  double t_next_x =
+      inv_dx == kInf ? kInf : ((d.x() > 0 ? (cx + 1 - gx) : (gx - cx)) * cell_) * inv_dx;
+  double t_next_y =
+      inv_dy == kInf ? kInf : ((d.y() > 0 ? (cy + 1 - gy) : (gy - cy)) * cell_) * inv_dy;
   const double t_dx = cell_ * inv_dx, t_dy = cell_ * inv_dy;
   double t_cell_start = 0.0;
   for (int guard = 0; guard < 100000; ++guard) {
@@ -232,68 +244,51 @@ std::optional<Hit> Scene::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& 
 }
 
 double Scene::DistanceToSurface(const Eigen::Vector3d& p, double search_radius) const {
-  double best = kInf;
-  best = std::min(best, std::fabs(p.z() - floor_z_));
+  double best = std::fabs(p.z() - floor_z_);
   if (ceiling_z_) best = std::min(best, std::fabs(p.z() - *ceiling_z_));
-  const int x0 = std::max(0, static_cast<int>(std::floor((p.x() - search_radius - origin_.x()) / cell_)));
-  const int y0 = std::max(0, static_cast<int>(std::floor((p.y() - search_radius - origin_.y()) / cell_)));
-  const int x1 = std::min(nx_ - 1, static_cast<int>(std::floor((p.x() + search_radius - origin_.x()) / cell_)));
-  const int y1 = std::min(ny_ - 1, static_cast<int>(std::floor((p.y() + search_radius - origin_.y()) / cell_)));
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const auto k = static_cast<std::size_t>(y * nx_ + x);
-      for (std::uint32_t i = cell_start_[k]; i < cell_start_[k + 1]; ++i) {
-        const std::uint32_t id = cells_[i];
-        if (id < boxes_.size()) {
-          const BoxPrimitive& b = boxes_[id];
-          const double px = p.x() - b.centre.x(), py = p.y() - b.centre.y();
-          const Eigen::Vector3d local(b.c * px + b.s * py, -b.s * px + b.c * py, p.z() - 0.5 * (b.z0 + b.z1));
-          const Eigen::Vector3d half(b.hx, b.hy, 0.5 * (b.z1 - b.z0));
-          const Eigen::Vector3d q = local.cwiseAbs() - half;
-          const double outside = q.cwiseMax(0.0).norm();
-          const double inside = std::min(0.0, q.maxCoeff());
-          best = std::min(best, std::fabs(outside + inside));
-        } else {
-          const CylinderPrimitive& c = cylinders_[id - boxes_.size()];
-          const double r = std::hypot(p.x() - c.centre.x(), p.y() - c.centre.y()) - c.radius;
-          const double h = std::max(c.z0 - p.z(), p.z() - c.z1);
-          const double outside = std::hypot(std::max(r, 0.0), std::max(h, 0.0));
-          const double inside = std::min(0.0, std::max(r, h));
-          best = std::min(best, std::fabs(outside + inside));
-        }
-      }
+  ForEachPrimitiveNear(p.head<2>(), search_radius, [&](std::uint32_t id) {
+    if (id < boxes_.size()) {
+      const BoxPrimitive& b = boxes_[id];
+      const double px = p.x() - b.centre.x(), py = p.y() - b.centre.y();
+      const Eigen::Vector3d local(b.c * px + b.s * py, -b.s * px + b.c * py,
+                                  p.z() - 0.5 * (b.z0 + b.z1));
+      const Eigen::Vector3d half(b.hx, b.hy, 0.5 * (b.z1 - b.z0));
+      const Eigen::Vector3d q = local.cwiseAbs() - half;
+      const double outside = q.cwiseMax(0.0).norm();
+      const double inside = std::min(0.0, q.maxCoeff());
+      best = std::min(best, std::fabs(outside + inside));
+    } else {
+      const CylinderPrimitive& c = cylinders_[id - boxes_.size()];
+      const double r = std::hypot(p.x() - c.centre.x(), p.y() - c.centre.y()) - c.radius;
+      const double h = std::max(c.z0 - p.z(), p.z() - c.z1);
+      const double outside = std::hypot(std::max(r, 0.0), std::max(h, 0.0));
+      const double inside = std::min(0.0, std::max(r, h));
+      best = std::min(best, std::fabs(outside + inside));
     }
-  }
+  });
   return best;
 }
 
-double Scene::FootprintDistance(const Eigen::Vector2d& p, double z_lo, double z_hi, double search_radius) const {
+double Scene::FootprintDistance(const Eigen::Vector2d& p,
+                                double z_lo,
+                                double z_hi,
+                                double search_radius) const {
   double best = kInf;
-  const int x0 = std::max(0, static_cast<int>(std::floor((p.x() - search_radius - origin_.x()) / cell_)));
-  const int y0 = std::max(0, static_cast<int>(std::floor((p.y() - search_radius - origin_.y()) / cell_)));
-  const int x1 = std::min(nx_ - 1, static_cast<int>(std::floor((p.x() + search_radius - origin_.x()) / cell_)));
-  const int y1 = std::min(ny_ - 1, static_cast<int>(std::floor((p.y() + search_radius - origin_.y()) / cell_)));
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const auto k = static_cast<std::size_t>(y * nx_ + x);
-      for (std::uint32_t i = cell_start_[k]; i < cell_start_[k + 1]; ++i) {
-        const std::uint32_t id = cells_[i];
-        double d = kInf;
-        if (id < boxes_.size()) {
-          const BoxPrimitive& b = boxes_[id];
-          if (b.z1 < z_lo || b.z0 > z_hi) continue;
-          const double px = p.x() - b.centre.x(), py = p.y() - b.centre.y();
-          const double qx = std::fabs(b.c * px + b.s * py) - b.hx, qy = std::fabs(-b.s * px + b.c * py) - b.hy;
-          d = std::hypot(std::max(qx, 0.0), std::max(qy, 0.0));
-        } else {
-          const CylinderPrimitive& c = cylinders_[id - boxes_.size()];
-          if (c.z1 < z_lo || c.z0 > z_hi) continue;
-          d = std::max(0.0, std::hypot(p.x() - c.centre.x(), p.y() - c.centre.y()) - c.radius);
-        }
-        best = std::min(best, d);
-      }
+  ForEachPrimitiveNear(p, search_radius, [&](std::uint32_t id) {
+    if (id < boxes_.size()) {
+      const BoxPrimitive& b = boxes_[id];
+      if (b.z1 < z_lo || b.z0 > z_hi) return;
+      const double px = p.x() - b.centre.x(), py = p.y() - b.centre.y();
+      const double qx = std::fabs(b.c * px + b.s * py) - b.hx,
+                   qy = std::fabs(-b.s * px + b.c * py) - b.hy;
+      best = std::min(best, std::hypot(std::max(qx, 0.0), std::max(qy, 0.0)));
+    } else {
+      const CylinderPrimitive& c = cylinders_[id - boxes_.size()];
+      if (c.z1 < z_lo || c.z0 > z_hi) return;
+      best = std::min(
+          best, std::max(0.0, std::hypot(p.x() - c.centre.x(), p.y() - c.centre.y()) - c.radius));
     }
-  }
+  });
   return best > search_radius ? kInf : best;
 }
 

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -33,7 +35,9 @@ class Scene {
   Scratch MakeScratch() const;
 
   /// Nearest surface along origin + t * direction (unit), 0 < t <= max_range.
-  std::optional<Hit> Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double max_range,
+  std::optional<Hit> Cast(const Eigen::Vector3d& origin,
+                          const Eigen::Vector3d& direction,
+                          double max_range,
                           Scratch& scratch) const;
 
   /// Distance from `p` to the nearest surface within `search_radius` (for residual tests);
@@ -42,7 +46,10 @@ class Scene {
 
   /// Horizontal distance from `p` to the footprint of every primitive that overlaps the height
   /// band [z_lo, z_hi] (0 inside one); +infinity beyond `search_radius`. For path planning.
-  double FootprintDistance(const Eigen::Vector2d& p, double z_lo, double z_hi, double search_radius) const;
+  double FootprintDistance(const Eigen::Vector2d& p,
+                           double z_lo,
+                           double z_hi,
+                           double search_radius) const;
 
   double floor_z() const { return floor_z_; }
   std::size_t primitives() const { return boxes_.size() + cylinders_.size(); }
@@ -50,8 +57,8 @@ class Scene {
  private:
   struct BoxPrimitive {
     Eigen::Vector2d centre;
-    double c, s;       // cos/sin of yaw
-    double hx, hy;     // half extents along the box axes
+    double c, s;    // cos/sin of yaw
+    double hx, hy;  // half extents along the box axes
     double z0, z1;
     Material material;
   };
@@ -62,7 +69,28 @@ class Scene {
   };
 
   void Insert(std::uint32_t id, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
-  bool TestPrimitive(std::uint32_t id, const Eigen::Vector3d& o, const Eigen::Vector3d& d, Hit& best) const;
+  bool TestPrimitive(std::uint32_t id,
+                     const Eigen::Vector3d& o,
+                     const Eigen::Vector3d& d,
+                     Hit& best) const;
+  // Calls visit(id) for every primitive listed in a grid cell within radius_m of p (a primitive
+  // spanning several cells is visited once per cell; the callers take minima, so that is harmless).
+  template <typename Visit>
+  void ForEachPrimitiveNear(const Eigen::Vector2d& p, double radius_m, Visit&& visit) const {
+    const auto cell_of = [&](double v, double o) {
+      return static_cast<int>(std::floor((v - o) / cell_));
+    };
+    const int x0 = std::max(0, cell_of(p.x() - radius_m, origin_.x()));
+    const int y0 = std::max(0, cell_of(p.y() - radius_m, origin_.y()));
+    const int x1 = std::min(nx_ - 1, cell_of(p.x() + radius_m, origin_.x()));
+    const int y1 = std::min(ny_ - 1, cell_of(p.y() + radius_m, origin_.y()));
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const auto k = static_cast<std::size_t>(y * nx_ + x);
+        for (std::uint32_t i = cell_start_[k]; i < cell_start_[k + 1]; ++i) visit(cells_[i]);
+      }
+    }
+  }
 
   double floor_z_ = 0.0;
   std::optional<double> ceiling_z_;
