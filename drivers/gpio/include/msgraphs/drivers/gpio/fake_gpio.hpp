@@ -23,9 +23,11 @@ class FakeGpioProvider : public GpioProvider {
     std::deque<EdgeEvent> pending_edges;
   };
 
-  Expected<std::unique_ptr<DigitalOutput>> OpenOutput(const GpioLineSpec& spec, const char* consumer,
+  Expected<std::unique_ptr<DigitalOutput>> OpenOutput(const GpioLineSpec& spec,
+                                                      const char* consumer,
                                                       bool initially_active) override;
-  Expected<std::unique_ptr<EdgeInput>> OpenEdgeInput(const GpioLineSpec& spec, const char* consumer,
+  Expected<std::unique_ptr<EdgeInput>> OpenEdgeInput(const GpioLineSpec& spec,
+                                                     const char* consumer,
                                                      Edge edge) override;
 
   /// Drives an input line to a physical level; queues an edge event if it changed and the
@@ -36,12 +38,15 @@ class FakeGpioProvider : public GpioProvider {
   std::uint64_t Changes(const GpioLineSpec& spec);
 
  private:
-  friend class FakeOutput;
-  friend class FakeInput;
+  friend class FakeLineClaim;
   struct Line : LineState {
     Edge edge = Edge::kBoth;
   };
   static std::string Key(const GpioLineSpec& spec) { return spec.chip + "/" + spec.line; }
+  /// The line for spec, created if new; mutex_ must be held.
+  std::shared_ptr<Line>& LineFor(const GpioLineSpec& spec);
+  /// Marks the line requested with spec's polarity, or fails if it already is; mutex_ must be held.
+  Expected<std::shared_ptr<Line>> Claim(const GpioLineSpec& spec);
 
   std::mutex mutex_;
   std::map<std::string, std::shared_ptr<Line>> lines_;
