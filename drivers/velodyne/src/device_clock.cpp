@@ -11,7 +11,7 @@ constexpr std::int64_t kHalfHourUs = 1'800'000'000;
 UnixTime DeviceClockSync::Map(UnixTime arrival, std::uint32_t device_time_us,
                               std::uint32_t packet_duration_ns) {
   std::int64_t hour = hours_;
-  if (!initialised_) {
+  if (!filter_.initialised()) {  // the first packet: nothing to unwrap against
     last_device_us_ = device_time_us;
   } else {
     const std::int64_t step = static_cast<std::int64_t>(device_time_us) - last_device_us_;
@@ -27,7 +27,6 @@ UnixTime DeviceClockSync::Map(UnixTime arrival, std::uint32_t device_time_us,
   }
   const std::int64_t device_ns =
       (hour * static_cast<std::int64_t>(kMicrosecondsPerHour) + device_time_us) * 1000;
-  initialised_ = true;
   // The packet arrives after its last firing: relate the arrival to that instant.
   const std::int64_t last_firing_ns = device_ns + packet_duration_ns;
   const std::int64_t host_last_firing_ns =

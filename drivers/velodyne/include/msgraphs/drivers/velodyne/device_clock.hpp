@@ -33,7 +33,6 @@ class DeviceClockSync {
 
  private:
   ClockOffsetFilter filter_;
-  bool initialised_ = false;
   std::uint32_t last_device_us_ = 0;
   std::int64_t hours_ = 0;
   std::uint64_t hour_wraps_ = 0;
