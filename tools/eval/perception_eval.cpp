@@ -32,6 +32,8 @@
 #include "msgraphs/drivers/velodyne/data_packet_decoder.hpp"
 #include "msgraphs/drivers/velodyne/device_clock.hpp"
 #include "msgraphs/drivers/velodyne/scan_assembler.hpp"
+#include "msgraphs/tools/recorded_scans.hpp"
+#include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
 #include "world.hpp"
 
@@ -39,38 +41,6 @@ namespace {
 
 using namespace msgraphs;
 namespace fs = std::filesystem;
-
-struct Stamped {
-  double t;
-  Eigen::Isometry3d T;
-};
-
-std::vector<Stamped> ReadTum(const std::string& path) {
-  std::vector<Stamped> out;
-  std::ifstream in(path);
-  double t, x, y, z, qx, qy, qz, qw;
-  while (in >> t >> x >> y >> z >> qx >> qy >> qz >> qw) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
-    T.translation() = Eigen::Vector3d(x, y, z);
-    out.push_back({t, T});
-  }
-  return out;
-}
-
-Eigen::Isometry3d PoseAt(const std::vector<Stamped>& tum, double t) {
-  if (tum.empty()) return Eigen::Isometry3d::Identity();
-  auto it = std::lower_bound(tum.begin(), tum.end(), t, [](const Stamped& s, double v) { return s.t < v; });
-  if (it == tum.begin()) return tum.front().T;
-  if (it == tum.end()) return tum.back().T;
-  const Stamped& b = *it;
-  const Stamped& a = *(it - 1);
-  const double f = (t - a.t) / (b.t - a.t);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = a.T.translation() + f * (b.T.translation() - a.T.translation());
-  T.linear() = Eigen::Quaterniond(a.T.linear()).slerp(f, Eigen::Quaterniond(b.T.linear())).toRotationMatrix();
-  return T;
-}
 
 // Walls merged across keyframes: the same line (angle, offset) with touching extents.
 struct MergedWall {
@@ -115,16 +85,23 @@ int main(int argc, char** argv) {
   bool markdown = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--run" && i + 1 < argc) run = argv[++i];
-    else if (a == "--keyframe-spacing-m" && i + 1 < argc) spacing = std::atof(argv[++i]);
-    else if (a == "--markdown") markdown = true;
+    if (a == "--run" && i + 1 < argc)
+      run = argv[++i];
+    else if (a == "--keyframe-spacing-m" && i + 1 < argc)
+      spacing = std::atof(argv[++i]);
+    else if (a == "--markdown")
+      markdown = true;
     else {
-      std::fprintf(stderr, "usage: msgraphs_eval_perception --run DIR [--keyframe-spacing-m 1.0] [--markdown]\n");
+      std::fprintf(
+          stderr,
+          "usage: msgraphs_eval_perception --run DIR [--keyframe-spacing-m 1.0] [--markdown]\n");
       return 2;
     }
   }
   if (run.empty()) {
-    std::fprintf(stderr, "usage: msgraphs_eval_perception --run DIR [--keyframe-spacing-m 1.0] [--markdown]\n");
+    std::fprintf(
+        stderr,
+        "usage: msgraphs_eval_perception --run DIR [--keyframe-spacing-m 1.0] [--markdown]\n");
     return 2;
   }
   std::string error;
@@ -137,8 +114,8 @@ int main(int argc, char** argv) {
   const Eigen::Isometry3d T_base_lidar(Eigen::Translation3d(0, 0, 0.30));
 
   constexpr std::size_t kMaxPoints = 60000;
-  BoundedVector<Eigen::Vector3f> scan_points(kMaxPoints), filtered(kMaxPoints), down(kMaxPoints), normals(kMaxPoints),
-      world_points(kMaxPoints);
+  BoundedVector<Eigen::Vector3f> scan_points(kMaxPoints), filtered(kMaxPoints), down(kMaxPoints),
+      normals(kMaxPoints), world_points(kMaxPoints);
   BoundedVector<Eigen::Matrix3f> covs(kMaxPoints);
   std::vector<float> times(kMaxPoints);
   core::VoxelDownsampler voxel;
@@ -170,28 +147,16 @@ int main(int argc, char** argv) {
   for (int robot = 1; robot <= 10; ++robot) {
     const fs::path dir = fs::path(run) / ("robot" + std::to_string(robot));
     if (!fs::exists(dir / "velodyne.pcap")) break;
-    const auto tum = ReadTum((dir / "ground_truth.tum").string());
-    auto reader = drivers::pcap::PcapFileReader::Open((dir / "velodyne.pcap").c_str());
-    if (!reader) return 1;
-    const auto decoder = drivers::velodyne::DataPacketDecoder::Create({}).value();
-    auto assembler = drivers::velodyne::ScanAssembler::Create({}).value();
-    drivers::velodyne::DeviceClockSync sync;
-    std::vector<drivers::velodyne::VelodynePoint> packet(drivers::velodyne::kMaxPointsPerPacket);
-    drivers::pcap::PcapRecord record;
-    drivers::pcap::PcapUdpCounters counters;
+    const auto tum = tools::ReadTum((dir / "ground_truth.tum").string());
+    auto scans = tools::RecordedScans::Open((dir / "velodyne.pcap").string());
+    if (!scans) return 1;
     Eigen::Isometry3d last_keyframe = Eigen::Isometry3d::Identity();
     bool have_keyframe = false;
-    while (reader->Next(record).value_or(false)) {
-      auto d = drivers::pcap::ExtractUdp(reader->header(), record, counters);
-      if (!d || d->payload.size() != drivers::velodyne::kDataPacketBytes) continue;
-      auto decoded = decoder.Decode(d->payload, packet);
-      if (!decoded) continue;
-      const UnixTime first = sync.Map(record.header.timestamp, decoded->device_time_us, decoded->packet_duration_ns);
-      if (!assembler.AddPacket(first, *decoded, std::span(packet).first(decoded->points))) continue;
-      const auto& scan = assembler.completed();
-      if (!scan.complete) continue;
-      const double t0 = scan.start_time.seconds_since_epoch(), t1 = scan.end_time.seconds_since_epoch();
-      const Eigen::Isometry3d T_world_end = PoseAt(tum, t1) * T_base_lidar;
+    while (const drivers::velodyne::Scan* next = scans->Next()) {
+      const auto& scan = *next;
+      const double t0 = scan.start_time.seconds_since_epoch(),
+                   t1 = scan.end_time.seconds_since_epoch();
+      const Eigen::Isometry3d T_world_end = tools::PoseAt(tum, t1) * T_base_lidar;
       if (have_keyframe) {
         const Eigen::Isometry3d delta = last_keyframe.inverse() * T_world_end;
         const double angle = Eigen::AngleAxisd(delta.linear()).angle();
@@ -206,8 +171,10 @@ int main(int argc, char** argv) {
         if (!scan_points.try_push_back(Eigen::Vector3f(p.x_m, p.y_m, p.z_m))) break;
         times[scan_points.size() - 1] = static_cast<float>(p.time_offset_ns * 1e-9);
       }
-      const Eigen::Isometry3d T_start_end = (PoseAt(tum, t0) * T_base_lidar).inverse() * T_world_end;
-      static_cast<void>(core::DeskewToEnd(scan_points.span(), std::span<const float>(times.data(), scan_points.size()),
+      const Eigen::Isometry3d T_start_end =
+          (tools::PoseAt(tum, t0) * T_base_lidar).inverse() * T_world_end;
+      static_cast<void>(core::DeskewToEnd(scan_points.span(),
+                                          std::span<const float>(times.data(), scan_points.size()),
                                           std::max(1e-3, t1 - t0), T_start_end));
       core::RangeFilter(scan_points.span(), 0.5f, 25.0f, filtered);
       static_cast<void>(voxel.Downsample(filtered.span(), 0.1f, down));
@@ -216,15 +183,19 @@ int main(int argc, char** argv) {
       if (!core::EstimateCovariances(down.span(), tree, {}, normals, covs, &origin)) continue;
       const auto p0 = std::chrono::steady_clock::now();
       static_cast<void>(planes_extractor.Extract(down.span(), normals.span(), {}, planes));
-      plane_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0).count();
+      plane_ms +=
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0).count();
       // Free space from the full-resolution sweep, in the world frame.
       world_points.clear();
-      for (const auto& p : filtered) static_cast<void>(world_points.try_push_back((T_world_end * p.cast<double>()).cast<float>()));
+      for (const auto& p : filtered)
+        static_cast<void>(
+            world_points.try_push_back((T_world_end * p.cast<double>()).cast<float>()));
       grid.Integrate(T_world_end.translation().cast<float>(), world_points.span(), 0.0f);
       for (const auto& p : down) {
         const Eigen::Vector3d q = T_world_end * p.cast<double>();
         const sim::Room* room = world->RoomAt(q.head<2>(), 0);
-        if (room == nullptr || q.z() < 0.05 || q.z() > 2.9) continue;  // walls and furniture, not floor or ceiling
+        if (room == nullptr || q.z() < 0.05 || q.z() > 2.9)
+          continue;  // walls and furniture, not floor or ceiling
         std::uint64_t key = 0;
         if (!core::VoxelKey(q.cast<float>(), 10.0f, key)) continue;
         room_voxels[{robot, static_cast<std::size_t>(room - world->rooms.data())}].insert(key);
@@ -242,7 +213,8 @@ int main(int argc, char** argv) {
         const double cu = plane.basis_u.dot(plane.centroid);
         w.a = c.head<2>() + u.head<2>() * (plane.u_min - cu);
         w.b = c.head<2>() + u.head<2>() * (plane.u_max - cu);
-        if (plane.u_max - plane.u_min < 0.5 || plane.z_max - plane.z_min < 0.8) continue;  // furniture faces
+        if (plane.u_max - plane.u_min < 0.5 || plane.z_max - plane.z_min < 0.8)
+          continue;  // furniture faces
         MergeWall(walls, w, static_cast<double>(plane.inliers));
       }
     }
@@ -254,7 +226,9 @@ int main(int argc, char** argv) {
     if ((m.wall.b - m.wall.a).norm() >= 1.0) map_walls.push_back(m.wall);
   }
   core::RoomSegmenter segmenter;
-  if (!segmenter.Init(grid.width(), grid.height(), 1024, std::max<std::size_t>(map_walls.size(), 1))) return 1;
+  if (!segmenter.Init(grid.width(), grid.height(), 1024,
+                      std::max<std::size_t>(map_walls.size(), 1)))
+    return 1;
   BoundedVector<core::RoomRegion> regions(1024);
   BoundedVector<core::DetectedRoom> rooms(256);
   static_cast<void>(segmenter.Segment(grid, {}, regions, map_walls));
@@ -282,14 +256,16 @@ int main(int argc, char** argv) {
       const Eigen::Vector2d across(std::cos(r.yaw_rad), std::sin(r.yaw_rad));
       centre_error = std::fabs(across.dot(r.centre - rect.centre));
     }
-    const double yaw_error = std::fabs(std::remainder(r.yaw_rad * 180.0 / std::numbers::pi - rect.orientation_deg, 90.0));
+    const double yaw_error = std::fabs(
+        std::remainder(r.yaw_rad * 180.0 / std::numbers::pi - rect.orientation_deg, 90.0));
     centre_error_sum += centre_error;
     centre_error_max = std::max(centre_error_max, centre_error);
     yaw_error_sum += yaw_error;
     yaw_error_max = std::max(yaw_error_max, yaw_error);
-    details << "  " << kind << " " << truth->id << ": centre error " << centre_error << " m, orientation error "
-            << yaw_error << " deg, size " << r.size_x_m << " x " << r.size_y_m << " (truth " << rect.width_m << " x "
-            << rect.length_m << " on centre lines)\n";
+    details << "  " << kind << " " << truth->id << ": centre error " << centre_error
+            << " m, orientation error " << yaw_error << " deg, size " << r.size_x_m << " x "
+            << r.size_y_m << " (truth " << rect.width_m << " x " << rect.length_m
+            << " on centre lines)\n";
   }
   // Which true rooms were observed: at least half of their area seen free.
   std::size_t observed = 0, observed_found = 0;
@@ -323,9 +299,11 @@ int main(int argc, char** argv) {
     std::vector<Eigen::Vector3f> cloud;
     for (std::uint64_t v : voxels) {
       Eigen::Vector3d q;
-      for (int a = 0; a < 3; ++a) q[a] = (static_cast<double>((v >> (21 * a)) & 0x1FFFFF) - (1 << 20) + 0.5) * 0.1;
+      for (int a = 0; a < 3; ++a)
+        q[a] = (static_cast<double>((v >> (21 * a)) & 0x1FFFFF) - (1 << 20) + 0.5) * 0.1;
       const Eigen::Vector2d xy = to_room * (q.head<2>() - rect.centre);
-      cloud.emplace_back(static_cast<float>(xy.x()), static_cast<float>(xy.y()), static_cast<float>(q.z()));
+      cloud.emplace_back(static_cast<float>(xy.x()), static_cast<float>(xy.y()),
+                         static_cast<float>(q.z()));
     }
     const core::ScanContextConfig sc_config;  // one absolute scale (12 m) for every room
     core::ScanContext sc;
@@ -362,34 +340,50 @@ int main(int argc, char** argv) {
     ++sc_queries;
     if (best_room == q.room) ++sc_top1;
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  const double precision = rooms.empty() ? 0.0 : static_cast<double>(true_positive) / static_cast<double>(rooms.size());
-  const double recall = observed == 0 ? 0.0 : static_cast<double>(observed_found) / static_cast<double>(observed);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  const double precision =
+      rooms.empty() ? 0.0 : static_cast<double>(true_positive) / static_cast<double>(rooms.size());
+  const double recall =
+      observed == 0 ? 0.0 : static_cast<double>(observed_found) / static_cast<double>(observed);
   const double n = std::max<double>(1.0, static_cast<double>(true_positive));
   if (markdown) {
-    std::printf("| %s | %zu | %zu | %zu / %zu (%zu as two-wall) | %.2f | %.2f | %.3f / %.3f | %.2f / %.2f | %.1f |\n",
-                world->name.c_str(), keyframes, map_walls.size(), true_positive, rooms.size(), as_corridor, precision,
-                recall, centre_error_sum / n, centre_error_max, yaw_error_sum / n, yaw_error_max,
-                plane_ms / std::max<double>(1, static_cast<double>(keyframes)));
+    std::printf(
+        "| %s | %zu | %zu | %zu / %zu (%zu as two-wall) | %.2f | %.2f | %.3f / %.3f | %.2f / %.2f "
+        "| %.1f |\n",
+        world->name.c_str(), keyframes, map_walls.size(), true_positive, rooms.size(), as_corridor,
+        precision, recall, centre_error_sum / n, centre_error_max, yaw_error_sum / n, yaw_error_max,
+        plane_ms / std::max<double>(1, static_cast<double>(keyframes)));
   } else {
-    std::printf("world %s: %zu keyframes, %zu vertical planes, %zu merged walls, %zu regions, %zu rooms/corridors detected\n",
-                world->name.c_str(), keyframes, vertical_planes, map_walls.size(), regions.size(), rooms.size());
+    std::printf(
+        "world %s: %zu keyframes, %zu vertical planes, %zu merged walls, %zu regions, %zu "
+        "rooms/corridors detected\n",
+        world->name.c_str(), keyframes, vertical_planes, map_walls.size(), regions.size(),
+        rooms.size());
     std::printf("%s", details.str().c_str());
     if (std::getenv("MSGRAPHS_EVAL_WALLS") != nullptr) {
       for (const auto& w : map_walls) {
-        std::printf("  wall %u: n (%.2f, %.2f) d %.2f from (%.2f, %.2f) to (%.2f, %.2f)\n", w.id, w.normal.x(), w.normal.y(), w.d,
-                    w.a.x(), w.a.y(), w.b.x(), w.b.y());
+        std::printf("  wall %u: n (%.2f, %.2f) d %.2f from (%.2f, %.2f) to (%.2f, %.2f)\n", w.id,
+                    w.normal.x(), w.normal.y(), w.d, w.a.x(), w.a.y(), w.b.x(), w.b.y());
       }
     }
-    std::printf("precision %.2f (%zu of %zu detections are true rooms; %zu rooms found by one wall pair only), recall %.2f (%zu of %zu observed rooms)\n",
-                precision, true_positive, rooms.size(), as_corridor, recall, observed_found, observed);
-    std::printf("centre error mean %.3f m, max %.3f m; orientation error mean %.2f deg, max %.2f deg\n",
-                centre_error_sum / n, centre_error_max, yaw_error_sum / n, yaw_error_max);
-    std::printf("scan context across robots: %zu room descriptors; same room mean distance %.3f (%zu pairs, %zu below SC_th 0.35), "
-                "different rooms %.3f (%zu pairs, %zu below 0.35); nearest is the same room for %zu of %zu\n",
-                descriptors.size(), same_sum / std::max<double>(1.0, static_cast<double>(same_n)), same_n, sc_below,
-                other_sum / std::max<double>(1.0, static_cast<double>(other_n)), other_n, sc_false_below, sc_top1, sc_queries);
-    std::printf("wall extraction %.1f ms per keyframe; total %.1f s\n", plane_ms / std::max<double>(1, static_cast<double>(keyframes)), seconds);
+    std::printf(
+        "precision %.2f (%zu of %zu detections are true rooms; %zu rooms found by one wall pair "
+        "only), recall %.2f (%zu of %zu observed rooms)\n",
+        precision, true_positive, rooms.size(), as_corridor, recall, observed_found, observed);
+    std::printf(
+        "centre error mean %.3f m, max %.3f m; orientation error mean %.2f deg, max %.2f deg\n",
+        centre_error_sum / n, centre_error_max, yaw_error_sum / n, yaw_error_max);
+    std::printf(
+        "scan context across robots: %zu room descriptors; same room mean distance %.3f (%zu "
+        "pairs, %zu below SC_th 0.35), "
+        "different rooms %.3f (%zu pairs, %zu below 0.35); nearest is the same room for %zu of "
+        "%zu\n",
+        descriptors.size(), same_sum / std::max<double>(1.0, static_cast<double>(same_n)), same_n,
+        sc_below, other_sum / std::max<double>(1.0, static_cast<double>(other_n)), other_n,
+        sc_false_below, sc_top1, sc_queries);
+    std::printf("wall extraction %.1f ms per keyframe; total %.1f s\n",
+                plane_ms / std::max<double>(1, static_cast<double>(keyframes)), seconds);
   }
   return 0;
 }

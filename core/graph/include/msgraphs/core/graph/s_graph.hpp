@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: MIT
+// The local S-Graph of one robot: an incremental four-layer factor graph on Ceres (private).
+//
+// Layers and their nodes (docs/s-graph.md):
+// - keyframes: SE(3) poses T_map_keyframe (quaternion + translation on Ceres' quaternion
+//   manifold). Keyframe 0 is the origin and fixes the gauge: it is held constant, always.
+// - walls (and the floor/ceiling planes): planes n.p + d = 0 in the map frame with a minimal
+//   parameterisation: the unit normal on Ceres' SphereManifold<3> (2 dof) and d (1 dof).
+// - rooms: a 2-D centre; four-wall rooms and two-wall corridors.
+// - floors: a 2-D centre tied weakly to each room.
+//
+// Factors: relative poses between keyframes (encoder odometry, scan matching, loop closures,
+// the composed factors that sparsification leaves), keyframe-to-plane, room-to-walls,
+// corridor-to-walls, wall-to-wall (a wall found twice) and floor-to-room. Every factor has a
+// Huber kernel whose threshold is in standard deviations of its whitened residual.
+//
+// Bounded: keyframes, planes, rooms and factors have capacities from the config. When the
+// keyframe store is full, a keyframe is sparsified: removed and its neighbours joined by the
+// composition of its two relative-pose factors (docs/s-graph.md says which one and why).
+//
+// Bad input never enters: non-finite or non-rigid poses, stamps that go backwards or repeat,
+// indefinite information, a plane seen from behind, factors between missing nodes; each is
+// refused with a status and counted. A solve that leaves anything non-finite is undone.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "msgraphs/base/expected.hpp"
+
+namespace msgraphs::core {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+struct SGraphConfig {
+  std::size_t max_keyframes = 4096;  ///< active keyframes; beyond, sparsification
+  std::size_t max_planes = 2048;
+  std::size_t max_rooms = 256;
+  /// Factor records (every kind). Enough for ~12 per keyframe by default; a full store refuses
+  /// new factors with kCapacityExceeded (counted).
+  std::size_t max_factors = 65536;
+  /// Huber thresholds, in standard deviations of the whitened residual.
+  double huber_relative_pose = 3.0;
+  double huber_loop_closure = 1.0;
+  double huber_plane = 2.0;
+  double huber_room = 2.0;
+  double room_sigma_m = 0.05;       ///< room centre against its walls' midlines
+  double wall_wall_sigma = 0.02;    ///< a wall found twice: normals (rad) and offsets (m)
+  double floor_room_sigma_m = 1.0;  ///< weak on purpose: rooms hold the floor, not the reverse
+  /// Local solve: the newest `local_window_keyframes` keyframes and what they observe move;
+  /// everything older is held. Bounded iterations and solver time.
+  std::size_t local_window_keyframes = 20;
+  int local_max_iterations = 10;
+  double local_max_seconds = 0.05;
+  /// Full solve (after a loop closure and every so often): everything but the origin moves.
+  int full_max_iterations = 100;
+  double full_max_seconds = 2.0;
+  Status Validate() const;
+};
+
+enum class RelativePoseKind : std::uint8_t { kOdometry, kScanMatch, kLoopClosure, kSparsified };
+enum class PlaneClass : std::uint8_t { kWall, kFloor, kCeiling };
+enum class SolveKind : std::uint8_t { kLocal, kFull };
+
+/// A plane measured in a keyframe's frame (n towards the sensor) with the covariance of the
+/// minimal perturbation (alpha, beta, delta_d) along basis_u and basis_v, as PlaneExtractor
+/// reports it.
+struct PlaneMeasurement {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+  double d = 0;
+  Eigen::Vector3d basis_u = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d basis_v = Eigen::Vector3d::UnitZ();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+
+struct MapPlane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit; the side it was seen from
+  double d = 0;
+  PlaneClass plane_class = PlaneClass::kWall;
+  std::uint32_t observations = 0;
+  std::uint32_t last_keyframe = 0;  ///< newest keyframe that observed it
+  bool active = false;
+};
+
+enum class RoomShape : std::uint8_t { kFourWall, kCorridor };
+
+struct MapRoom {
+  RoomShape shape = RoomShape::kFourWall;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  /// Walls: low x, high x, low y, high y of the room frame (a corridor: the first pair only;
+  /// -1 where absent). Every pair faces into the room.
+  std::array<std::int32_t, 4> walls{-1, -1, -1, -1};
+  Eigen::Vector2d corridor_anchor = Eigen::Vector2d::Zero();  ///< where along a corridor it is
+  bool active = false;
+};
+
+struct SGraphSolveReport {
+  SolveKind kind = SolveKind::kLocal;
+  bool usable = false;     ///< the solver finished with a finite state (else it was undone)
+  bool converged = false;  ///< met its tolerances (not just the iteration or time limit)
+  int iterations = 0;
+  double initial_cost = 0, final_cost = 0;
+  double seconds = 0;  ///< as Ceres measured it
+  std::size_t free_keyframes = 0;
+};
+
+struct SGraphStats {
+  std::size_t keyframes = 0, keyframes_peak = 0, sparsified = 0;
+  std::size_t planes = 0, rooms = 0, floors = 0;
+  std::size_t factors = 0, factors_peak = 0;
+  std::array<std::size_t, 4> relative_factors{};  ///< by RelativePoseKind
+  std::size_t plane_factors = 0, room_factors = 0, wall_wall_factors = 0, floor_factors = 0;
+  // Refused input, by reason.
+  std::uint64_t rejected_pose = 0;          ///< non-finite or non-rigid pose or measurement
+  std::uint64_t rejected_stamp = 0;         ///< keyframe stamp not after the previous one
+  std::uint64_t rejected_information = 0;   ///< information not symmetric positive definite
+  std::uint64_t rejected_behind = 0;        ///< plane seen from its back side
+  std::uint64_t rejected_missing_node = 0;  ///< factor to a node that does not exist (any more)
+  std::uint64_t rejected_capacity = 0;
+  std::uint64_t solves = 0, solves_not_converged = 0, solves_undone = 0;
+  /// Bytes of our own stores (fixed at Init). Ceres' problem grows with the graph, and the
+  /// graph is bounded, so its size is bounded too; tools report the process peak.
+  std::size_t store_bytes = 0;
+};
+
+class SGraph {
+ public:
+  SGraph();
+  ~SGraph();
+  SGraph(const SGraph&) = delete;
+  SGraph& operator=(const SGraph&) = delete;
+
+  Status Init(const SGraphConfig& config);
+
+  /// A new keyframe with its initial estimate. The first one becomes the origin (held fixed).
+  /// kOutOfOrder when `stamp_s` is not after the last keyframe's; kInvalidArgument for a
+  /// non-rigid or non-finite pose. Sparsifies first when the store is full.
+  Expected<std::uint32_t> AddKeyframe(double stamp_s, const Eigen::Isometry3d& T_map_keyframe);
+
+  /// Relative pose measurement T_from_to with its information over [t; rotation vector].
+  /// Returns the factor's id (for FactorChi2 / RemoveFactor).
+  Expected<std::uint32_t> AddRelativePose(std::uint32_t from,
+                                          std::uint32_t to,
+                                          const Eigen::Isometry3d& T_from_to,
+                                          const Matrix6d& information,
+                                          RelativePoseKind kind);
+
+  /// The squared whitened residual of a factor at the current estimate, without its robust
+  /// kernel: how far the optimised graph disagrees with it, in units of its own variance.
+  Expected<double> FactorChi2(std::uint32_t factor) const;
+  /// Removes a factor (a loop closure the rest of the graph contradicts).
+  Status RemoveFactor(std::uint32_t factor);
+
+  /// A new plane landmark in the map frame (normal normalised here).
+  Expected<std::uint32_t> AddPlane(const Eigen::Vector3d& normal_map,
+                                   double d_map,
+                                   PlaneClass plane_class);
+
+  /// Keyframe-to-plane factor. kInvalidArgument (counted as "behind") when the keyframe's
+  /// current estimate lies behind the plane by more than `behind_margin_m` or the measured
+  /// normal disagrees with the predicted one by more than 60 degrees: a wall seen from behind is
+  /// the other face of the wall, never this landmark.
+  Status AddPlaneObservation(std::uint32_t keyframe,
+                             std::uint32_t plane,
+                             const PlaneMeasurement& measurement,
+                             double behind_margin_m = 0.1);
+
+  /// A room (or corridor) node and its wall factor. For a corridor only walls[0..1] are used and
+  /// `corridor_anchor` fixes the position along it.
+  Expected<std::uint32_t> AddRoom(const MapRoom& room);
+  /// Replaces the room's walls (a better wall pair found, a corridor completed to a room).
+  Status UpdateRoom(std::uint32_t room, const MapRoom& updated);
+  Status RemoveRoom(std::uint32_t room);
+
+  /// Two landmarks found to be the same wall: ties them together.
+  Status AddWallWall(std::uint32_t plane_a, std::uint32_t plane_b);
+
+  /// Creates the floor node (once) at `centre`, or moves its estimate. Each room joins it with
+  /// a weak factor through AddFloorRoom.
+  Status SetFloor(const Eigen::Vector2d& centre);
+  Status AddFloorRoom(std::uint32_t room);
+
+  Expected<SGraphSolveReport> Solve(SolveKind kind);
+
+  // ---- state ----
+  std::size_t keyframe_slots() const;  ///< ids handed out so far (active or sparsified)
+  bool keyframe_active(std::uint32_t id) const;
+  Eigen::Isometry3d keyframe_pose(std::uint32_t id) const;
+  double keyframe_stamp(std::uint32_t id) const;
+  std::size_t plane_slots() const;
+  MapPlane plane(std::uint32_t id) const;
+  std::size_t room_slots() const;
+  MapRoom room(std::uint32_t id) const;
+  bool has_floor() const;
+  Eigen::Vector2d floor_centre() const;
+  /// The newest keyframes (oldest first, up to out.size()) that are active.
+  std::size_t RecentKeyframes(std::span<std::uint32_t> out) const;
+  SGraphStats stats() const;
+  const SGraphConfig& config() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace msgraphs::core

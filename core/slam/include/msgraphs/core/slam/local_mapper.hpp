@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: MIT
+// The local S-Graph front end of one robot: scans and encoder odometry in, the four-layer graph
+// out (docs/s-graph.md).
+//
+// Per scan: odometry at the scan's start and end (OdometryBuffer); a keyframe when the robot
+// moved keyframe_spacing_m or turned keyframe_angle_rad since the last one. Other scans cost
+// two lookups and nothing else.
+// Per keyframe: deskew with the odometry's motion, range filter, base frame, 0.1 m voxels,
+// normals and covariances; VGICP against the local map (the last keyframes' clouds in the last
+// keyframe's frame) seeded by odometry, checked (convergence, fitness, overlap, divergence from
+// the odometry) and added as a scan-matching factor beside the encoder factor; planes extracted
+// and associated (PlaneMapper); free space integrated; a bounded local solve; loop-closure
+// search (LoopCloser) and a full solve after one; rooms and the floor every few keyframes
+// (RoomMapper).
+//
+// Core has no clock: an optional StageObserver, given by the caller, is told when each stage
+// ends, so tools measure per-stage times. Every buffer is sized at Init; the per-scan path
+// allocates nothing; per keyframe, only Ceres allocates (factor storage and solver workspace,
+// bounded by the graph's capacities).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "msgraphs/base/bounded_vector.hpp"
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/perception/covariances.hpp"
+#include "msgraphs/core/perception/free_space_grid.hpp"
+#include "msgraphs/core/perception/kdtree.hpp"
+#include "msgraphs/core/perception/plane_extraction.hpp"
+#include "msgraphs/core/perception/voxel_grid.hpp"
+#include "msgraphs/core/registration/gaussian_voxel_map.hpp"
+#include "msgraphs/core/registration/vgicp.hpp"
+#include "msgraphs/core/slam/keyframe_cloud_store.hpp"
+#include "msgraphs/core/slam/loop_closer.hpp"
+#include "msgraphs/core/slam/odometry_buffer.hpp"
+#include "msgraphs/core/slam/plane_mapper.hpp"
+#include "msgraphs/core/slam/room_mapper.hpp"
+
+namespace msgraphs::core {
+
+struct LocalMapperConfig {
+  Eigen::Isometry3d T_base_lidar = Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.30));
+  double base_height_m = 0.5;  ///< base frame above the floor (Spot walking)
+  double keyframe_spacing_m = 1.0;
+  double keyframe_angle_rad = 0.35;
+  float min_range_m = 0.5f, max_range_m = 25.0f;
+  float voxel_m = 0.1f;        ///< the keyframe cloud: planes and the scan-matching source
+  float store_voxel_m = 0.2f;  ///< stored clouds: local map and loop-closure targets
+  std::size_t max_scan_points = 60000;
+  std::size_t local_map_keyframes = 10;
+  double local_map_resolution_m = 0.4;  ///< VGICP voxels of the local map
+  double scan_match_sigma_m = 0.02;     ///< strongest direction; the Hessian gives the rest
+  double scan_match_max_fitness_m2 = 0.05;
+  double scan_match_min_overlap = 0.5;
+  double max_correction_m = 0.25;   ///< scan matching may move the odometry's guess this much
+  double max_correction_rad = 0.1;  ///< ...and turn it this much, else it diverged
+  /// Encoder odometry factor: sigma grows with the motion (Spot's drawn 1-2 % scale error and
+  /// ~1 degree per 10 m of yaw drift fit well inside these).
+  double odometry_sigma_per_m = 0.03, odometry_sigma_min_m = 0.01;
+  double odometry_rotation_sigma_per_m = 0.005, odometry_rotation_sigma_min = 0.002;
+  double odometry_gap_inflation = 10.0;  ///< sigma factor when the odometry bridged a gap
+  std::size_t room_update_every_keyframes = 5;
+  std::size_t full_solve_every_keyframes = 50;
+  std::size_t cloud_store_points = 1500000;
+  std::size_t odometry_capacity = 4096;
+  double odometry_max_gap_s = 0.1;
+  SGraphConfig graph;
+  PlaneExtractionConfig planes;
+  PlaneAssociationConfig association;
+  RoomMapperConfig rooms;
+  FreeSpaceGridConfig grid;
+  LoopClosureConfig loops;
+  /// Fitness leaves out points farther than 1 m from the map: a keyframe sees new space that
+  /// the local map cannot contain, and that is not misalignment.
+  VgicpConfig scan_matching = VgicpWithFitnessWithin(1.0);
+  Status Validate() const;
+};
+
+/// One assembled sweep: points in the lidar frame with their time after `start_s`.
+struct LidarScanView {
+  std::span<const Eigen::Vector3f> points_lidar;
+  std::span<const float> time_offset_s;
+  double start_s = 0, end_s = 0;
+};
+
+enum class ScanOutcome : std::uint8_t { kNotKeyframe, kKeyframe, kNoOdometry };
+
+enum class MapperStage : std::uint8_t {
+  kPreprocess,
+  kScanMatching,
+  kPlanes,
+  kFreeSpace,
+  kLocalSolve,
+  kLoopClosure,
+  kFullSolve,
+  kRooms,
+  kCount
+};
+const char* ToString(MapperStage stage);
+
+/// Told when each stage of a keyframe ends (core has no clock; the caller's observer has one).
+class StageObserver {
+ public:
+  virtual ~StageObserver() = default;
+  virtual void KeyframeStarted() = 0;
+  virtual void StageEnded(MapperStage stage) = 0;
+};
+
+struct LocalMapperStats {
+  std::uint64_t scans = 0, keyframes = 0;
+  std::uint64_t no_odometry = 0;  ///< scan outside the odometry buffered (skipped, counted)
+  std::uint64_t odometry_gap_keyframes = 0;
+  std::uint64_t bad_scans = 0;  ///< too few points, or mismatched spans
+  std::uint64_t scan_match_accepted = 0;
+  std::uint64_t scan_match_rejected_fitness = 0, scan_match_rejected_overlap = 0,
+                scan_match_rejected_diverged = 0, scan_match_rejected_failed = 0;
+  std::uint64_t loop_closures = 0, full_solves = 0;
+  std::size_t local_map_points_peak = 0;
+};
+
+class LocalMapper {
+ public:
+  Status Init(const LocalMapperConfig& config);
+
+  /// Encoder odometry (base frame in the odometry frame), in time order.
+  Status AddOdometry(double stamp_s, const Eigen::Isometry3d& T_odom_base);
+
+  /// kNoOdometry: the scan's end is not inside the buffered odometry (feed odometry first).
+  Expected<ScanOutcome> AddScan(const LidarScanView& scan, StageObserver* observer = nullptr);
+
+  /// A full solve now (for example at the end of a mission).
+  Status Finish();
+
+  const SGraph& graph() const { return graph_; }
+  /// The map-from-odometry correction at the newest keyframe: T_map_base = T_map_odom *
+  /// T_odom_base.
+  Eigen::Isometry3d T_map_odom() const { return T_map_odom_; }
+  /// Encoder odometry at a keyframe (for the encoder-only baseline of the same keyframes).
+  Eigen::Isometry3d keyframe_odometry(std::uint32_t keyframe) const {
+    return keyframe_odometry_[keyframe];
+  }
+  const LocalMapperStats& stats() const { return stats_; }
+  const PlaneMapper& plane_mapper() const { return planes_mapper_; }
+  const RoomMapper& room_mapper() const { return rooms_; }
+  const LoopCloser& loop_closer() const { return loops_; }
+  const OdometryBuffer& odometry() const { return odometry_; }
+  const KeyframeCloudStore& clouds() const { return clouds_; }
+  const FreeSpaceGrid& grid() const { return grid_; }
+  const LocalMapperConfig& config() const { return config_; }
+
+ private:
+  void Stage(StageObserver* observer, MapperStage stage) const {
+    if (observer != nullptr) observer->StageEnded(stage);
+  }
+  bool Preprocess(const LidarScanView& scan,
+                  const Eigen::Isometry3d& T_odom_start,
+                  const Eigen::Isometry3d& T_odom_end);
+  bool BuildLocalMap(std::uint32_t last);
+  Matrix6d OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const;
+
+  LocalMapperConfig config_;
+  SGraph graph_;
+  OdometryBuffer odometry_;
+  KeyframeCloudStore clouds_;
+  PlaneMapper planes_mapper_;
+  RoomMapper rooms_;
+  LoopCloser loops_;
+  FreeSpaceGrid grid_;
+  PlaneExtractor extractor_;
+  VoxelDownsampler voxel_;
+  KdTree tree_, local_tree_;
+  GaussianVoxelMap local_map_;
+  Vgicp vgicp_;
+  BoundedVector<Eigen::Vector3f> work_, filtered_, down_, normals_, stored_, local_raw_,
+      local_points_, local_normals_, world_points_;
+  BoundedVector<Eigen::Matrix3f> covariances_, local_covariances_;
+  BoundedVector<float> times_;
+  BoundedVector<ExtractedPlane> planes_;
+  std::vector<std::uint64_t> sequence_;               // per keyframe slot
+  std::vector<Eigen::Isometry3d> keyframe_odometry_;  // per keyframe slot
+  std::vector<std::uint32_t> recent_;
+  std::uint64_t next_sequence_ = 1;
+  bool have_keyframe_ = false;
+  std::uint32_t last_keyframe_ = 0;
+  Eigen::Isometry3d last_odometry_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
+  double path_m_ = 0;
+  std::size_t keyframes_since_rooms_ = 0, keyframes_since_full_ = 0;
+  LocalMapperStats stats_;
+};
+
+}  // namespace msgraphs::core

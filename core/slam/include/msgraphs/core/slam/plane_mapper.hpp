@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+// Plane data association for the local S-Graph: each plane extracted from a keyframe goes to
+// the mapped plane it matches, or becomes a new one.
+//
+// Unlike the original (reference/original-s-graphs-notes.md 1.7 and 1.17):
+// - the gate is a true Mahalanobis distance in the measurement's minimal coordinates
+//   (alpha, beta, delta_d) with the extractor's fitted covariance plus the keyframe's and the
+//   landmark's uncertainty in radians and metres, against a chi-square threshold;
+// - a wall must also overlap the mapped wall's extent along it (within a gap): two rooms'
+//   collinear walls stay two walls; an interval test, not the O(N M) point check;
+// - horizontal planes (floor and ceiling) are associated too, on the same rule;
+// - a plane seen from its back (the other face of a wall) never associates.
+// Wall extents (endpoints along the wall and heights) are kept here, in the map frame, for
+// room detection. Sized at Init; Associate allocates nothing.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <span>
+#include <vector>
+
+#include "msgraphs/base/bounded_vector.hpp"
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/perception/plane_extraction.hpp"
+#include "msgraphs/core/perception/room_segmentation.hpp"
+
+namespace msgraphs::core {
+
+struct PlaneAssociationConfig {
+  double gate_chi2 = 16.27;            ///< 3 dof, 99.9 %
+  double pose_sigma_rad = 0.035;       ///< keyframe-plus-landmark uncertainty: 2 degrees
+  double pose_sigma_m = 0.02;          ///< (tighter merges parallel walls 10 cm apart)
+  double max_normal_angle_deg = 25.0;  ///< coarse pre-gate before the Mahalanobis test
+  double extent_gap_m = 1.0;           ///< a wall's new piece must be this close to its extent
+  double min_wall_length_m = 0.5;      ///< shorter or lower vertical planes are furniture faces
+  double min_wall_height_m = 0.8;
+  double covariance_floor_m = 0.01;  ///< per-axis floor on the measured covariance (sigma)
+  Status Validate() const;
+};
+
+struct PlaneAssociationStats {
+  std::uint64_t associated = 0, created = 0, furniture = 0, slanted = 0, rejected = 0;
+};
+
+/// A wall's extent in the map frame: its two ends (xy) and the heights seen.
+struct WallExtent {
+  Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::Zero();
+  double z_min = 0, z_max = 0;
+  bool valid = false;
+};
+
+class PlaneMapper {
+ public:
+  Status Init(std::size_t max_planes, const PlaneAssociationConfig& config);
+
+  /// Associates the keyframe's planes (keyframe frame) through the graph's current estimate of
+  /// the keyframe and adds the observations (creating planes as needed).
+  Status Associate(SGraph& graph, std::uint32_t keyframe, std::span<const ExtractedPlane> planes);
+
+  /// Walls for room detection: every wall observed at least `min_observations` times, as 2-D
+  /// lines from the graph's current estimate with the stored extent projected onto them.
+  /// `ids[i]` is the graph plane of `walls[i]`.
+  void MapWalls(const SGraph& graph,
+                std::uint32_t min_observations,
+                BoundedVector<MapWall>& walls,
+                BoundedVector<std::uint32_t>& ids) const;
+
+  const WallExtent& extent(std::uint32_t plane) const { return extents_[plane]; }
+  const PlaneAssociationStats& stats() const { return stats_; }
+
+ private:
+  PlaneAssociationConfig config_;
+  std::vector<WallExtent> extents_;
+  PlaneAssociationStats stats_;
+};
+
+}  // namespace msgraphs::core

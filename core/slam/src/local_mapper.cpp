@@ -1,0 +1,314 @@
+// SPDX-License-Identifier: MIT
+#include "msgraphs/core/slam/local_mapper.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "msgraphs/core/geometry/se3.hpp"
+#include "msgraphs/core/perception/deskew.hpp"
+
+namespace msgraphs::core {
+
+const char* ToString(MapperStage stage) {
+  switch (stage) {
+    case MapperStage::kPreprocess:
+      return "preprocess";
+    case MapperStage::kScanMatching:
+      return "scan matching";
+    case MapperStage::kPlanes:
+      return "planes";
+    case MapperStage::kFreeSpace:
+      return "free space";
+    case MapperStage::kLocalSolve:
+      return "local solve";
+    case MapperStage::kLoopClosure:
+      return "loop closure";
+    case MapperStage::kFullSolve:
+      return "full solve";
+    case MapperStage::kRooms:
+      return "rooms";
+    case MapperStage::kCount:
+      break;
+  }
+  return "?";
+}
+
+Status LocalMapperConfig::Validate() const {
+  if (!IsValidRigidTransform(T_base_lidar, 1e-6))
+    return Error{Errc::kInvalidConfig, "mapper: T_base_lidar not rigid"};
+  if (!(keyframe_spacing_m > 0) || !(keyframe_angle_rad > 0) || !(voxel_m > 0) ||
+      !(store_voxel_m >= voxel_m) || !(min_range_m >= 0) || !(max_range_m > min_range_m) ||
+      max_scan_points < 100 || local_map_keyframes < 1 || !(local_map_resolution_m > 0) ||
+      !(scan_match_sigma_m > 0) || !(scan_match_max_fitness_m2 > 0) ||
+      !(scan_match_min_overlap > 0 && scan_match_min_overlap <= 1) || !(max_correction_m > 0) ||
+      !(max_correction_rad > 0) || !(odometry_sigma_min_m > 0) ||
+      !(odometry_rotation_sigma_min > 0) || !(odometry_sigma_per_m >= 0) ||
+      !(odometry_rotation_sigma_per_m >= 0) || !(odometry_gap_inflation >= 1) ||
+      room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 ||
+      cloud_store_points < max_scan_points || odometry_capacity < 16 || !(odometry_max_gap_s > 0)) {
+    return Error{Errc::kInvalidConfig,
+                 "mapper: spacing, voxels, ranges, sigmas and capacities must be positive"};
+  }
+  for (const Status& s :
+       {graph.Validate(), planes.Validate(), association.Validate(), rooms.Validate(),
+        grid.Validate(), loops.Validate(), scan_matching.Validate()}) {
+    if (!s) return s;
+  }
+  return Ok();
+}
+
+Status LocalMapper::Init(const LocalMapperConfig& config) {
+  if (auto s = config.Validate(); !s) return s;
+  config_ = config;
+  if (auto s = graph_.Init(config.graph); !s) return s;
+  odometry_.Init(config.odometry_capacity, config.odometry_max_gap_s);
+  const std::size_t slots = config.graph.max_keyframes + 1;
+  clouds_.Init(slots, config.cloud_store_points);
+  if (auto s = planes_mapper_.Init(config.graph.max_planes, config.association); !s) return s;
+  if (auto s = rooms_.Init(config.grid, 1024, config.graph.max_rooms, config.rooms); !s) return s;
+  if (auto s = loops_.Init(slots, config.max_scan_points, config.loops); !s) return s;
+  if (auto s = grid_.Init(config.grid); !s) return s;
+  const std::size_t n = config.max_scan_points;
+  const std::size_t local_n = n * 2;  // the local map, after downsampling
+  extractor_.Init(n);
+  voxel_.Init(std::max(n, config.local_map_keyframes * n));
+  tree_.Init(n);
+  local_tree_.Init(local_n);
+  local_map_.Init(local_n);
+  vgicp_.Init(n);
+  for (auto* b : {&work_, &filtered_, &down_, &normals_, &stored_, &world_points_}) b->Init(n);
+  local_raw_.Init(config.local_map_keyframes * n);
+  local_points_.Init(local_n);
+  local_normals_.Init(local_n);
+  covariances_.Init(n);
+  local_covariances_.Init(local_n);
+  times_.Init(n);
+  planes_.Init(config.planes.max_planes);
+  sequence_.assign(slots, 0);
+  keyframe_odometry_.assign(slots, Eigen::Isometry3d::Identity());
+  recent_.assign(config.local_map_keyframes, 0);
+  next_sequence_ = 1;
+  have_keyframe_ = false;
+  T_map_odom_ = Eigen::Isometry3d::Identity();
+  path_m_ = 0;
+  keyframes_since_rooms_ = keyframes_since_full_ = 0;
+  stats_ = {};
+  return Ok();
+}
+
+Status LocalMapper::AddOdometry(double stamp_s, const Eigen::Isometry3d& T_odom_base) {
+  return odometry_.Add(stamp_s, T_odom_base);
+}
+
+Matrix6d LocalMapper::OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const {
+  const double distance = delta.translation().norm();
+  double sigma_t = std::max(config_.odometry_sigma_min_m, config_.odometry_sigma_per_m * distance);
+  double sigma_r = std::max(config_.odometry_rotation_sigma_min,
+                            config_.odometry_rotation_sigma_per_m * distance);
+  if (across_gap) {
+    sigma_t *= config_.odometry_gap_inflation;
+    sigma_r *= config_.odometry_gap_inflation;
+  }
+  Matrix6d information = Matrix6d::Zero();
+  information.diagonal() << Eigen::Vector3d::Constant(1.0 / (sigma_t * sigma_t)),
+      Eigen::Vector3d::Constant(1.0 / (sigma_r * sigma_r));
+  return information;
+}
+
+bool LocalMapper::Preprocess(const LidarScanView& scan,
+                             const Eigen::Isometry3d& T_odom_start,
+                             const Eigen::Isometry3d& T_odom_end) {
+  work_.clear();
+  times_.clear();
+  for (std::size_t i = 0; i < scan.points_lidar.size(); ++i) {
+    if (!work_.try_push_back(scan.points_lidar[i]))
+      break;  // beyond max_scan_points: counted by the caller's size
+    static_cast<void>(times_.try_push_back(scan.time_offset_s[i]));
+  }
+  // Deskew to the end of the sweep with the odometry's motion in the lidar frame.
+  const Eigen::Isometry3d T_start_end =
+      (T_odom_start * config_.T_base_lidar).inverse() * (T_odom_end * config_.T_base_lidar);
+  static_cast<void>(DeskewToEnd(work_.span(), times_.span(),
+                                std::max(1e-3, scan.end_s - scan.start_s), T_start_end));
+  RangeFilter(work_.span(), config_.min_range_m, config_.max_range_m, filtered_);
+  const Eigen::Affine3f T_base_lidar = config_.T_base_lidar.cast<float>();
+  for (Eigen::Vector3f& p : filtered_) p = T_base_lidar * p;
+  if (!voxel_.Downsample(filtered_.span(), config_.voxel_m, down_) || down_.size() < 100)
+    return false;
+  if (!tree_.Build(down_.span())) return false;
+  const Eigen::Vector3f viewpoint = config_.T_base_lidar.translation().cast<float>();
+  if (!EstimateCovariances(down_.span(), tree_, {}, normals_, covariances_, &viewpoint))
+    return false;
+  return true;
+}
+
+// The last keyframes' stored clouds in the frame of keyframe `last`, downsampled, with their
+// own covariances (from the union, which is denser than any one keyframe).
+bool LocalMapper::BuildLocalMap(std::uint32_t last) {
+  const std::size_t count = graph_.RecentKeyframes(std::span(recent_));
+  const Eigen::Isometry3d T_last_map = graph_.keyframe_pose(last).inverse();
+  local_raw_.clear();
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint32_t k = recent_[i];
+    const auto cloud = clouds_.Get(k, sequence_[k]);
+    const Eigen::Affine3f T = (T_last_map * graph_.keyframe_pose(k)).cast<float>();
+    for (const Eigen::Vector3f& p : cloud) {
+      if (!local_raw_.try_push_back(T * p)) break;
+    }
+  }
+  if (!voxel_.Downsample(local_raw_.span(), config_.store_voxel_m, local_points_) ||
+      local_points_.size() < 100) {
+    return false;
+  }
+  stats_.local_map_points_peak = std::max(stats_.local_map_points_peak, local_points_.size());
+  if (!local_tree_.Build(local_points_.span())) return false;
+  if (!EstimateCovariances(local_points_.span(), local_tree_, {}, local_normals_,
+                           local_covariances_))
+    return false;
+  return static_cast<bool>(local_map_.Build(local_points_.span(), local_covariances_.span(),
+                                            config_.local_map_resolution_m));
+}
+
+Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObserver* observer) {
+  ++stats_.scans;
+  if (scan.points_lidar.size() != scan.time_offset_s.size() || !std::isfinite(scan.start_s) ||
+      !std::isfinite(scan.end_s) || scan.end_s < scan.start_s) {
+    ++stats_.bad_scans;
+    return Error{Errc::kInvalidArgument, "scan: points and times differ in length, or bad stamps"};
+  }
+  const auto at_end = odometry_.At(scan.end_s);
+  const auto at_start = odometry_.At(scan.start_s);
+  if (!at_end || !at_start) {
+    ++stats_.no_odometry;
+    return ScanOutcome::kNoOdometry;
+  }
+  const Eigen::Isometry3d T_odom_now = at_end->T_odom_base;
+  const Eigen::Isometry3d delta = last_odometry_.inverse() * T_odom_now;
+  if (have_keyframe_) {
+    const double angle = Eigen::AngleAxisd(delta.linear()).angle();
+    if (delta.translation().norm() < config_.keyframe_spacing_m &&
+        angle < config_.keyframe_angle_rad) {
+      return ScanOutcome::kNotKeyframe;
+    }
+    if (!(scan.end_s > graph_.keyframe_stamp(last_keyframe_))) return ScanOutcome::kNotKeyframe;
+  }
+  // ---- a keyframe ----
+  if (observer != nullptr) observer->KeyframeStarted();
+  if (!Preprocess(scan, at_start->T_odom_base, T_odom_now)) {
+    ++stats_.bad_scans;
+    return Error{Errc::kDegenerate, "keyframe scan has too few usable points"};
+  }
+  Stage(observer, MapperStage::kPreprocess);
+  const bool across_gap = at_end->across_gap || at_start->across_gap;
+  Eigen::Isometry3d T_map_new = T_map_odom_ * T_odom_now;
+  bool matched = false;
+  Eigen::Isometry3d T_last_new = delta;
+  Matrix6d match_information = Matrix6d::Identity();
+  if (have_keyframe_ && BuildLocalMap(last_keyframe_)) {
+    auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_, local_points_.span(),
+                               local_tree_, delta, config_.scan_matching);
+    if (!result || !result->converged) {
+      ++stats_.scan_match_rejected_failed;
+    } else if (result->fitness > config_.scan_match_max_fitness_m2) {
+      ++stats_.scan_match_rejected_fitness;
+    } else if (static_cast<double>(result->correspondences) <
+               config_.scan_match_min_overlap * static_cast<double>(down_.size())) {
+      ++stats_.scan_match_rejected_overlap;
+    } else {
+      const Eigen::Isometry3d correction = delta.inverse() * result->T_target_source;
+      if (correction.translation().norm() > config_.max_correction_m ||
+          Eigen::AngleAxisd(correction.linear()).angle() > config_.max_correction_rad) {
+        ++stats_.scan_match_rejected_diverged;
+      } else {
+        matched = true;
+        T_last_new = result->T_target_source;
+        match_information = InformationFromHessian(result->hessian, config_.scan_match_sigma_m);
+        T_map_new = graph_.keyframe_pose(last_keyframe_) * T_last_new;
+        ++stats_.scan_match_accepted;
+      }
+    }
+  } else if (have_keyframe_) {
+    ++stats_.scan_match_rejected_failed;
+  }
+  Stage(observer, MapperStage::kScanMatching);
+  if (have_keyframe_ && !matched) T_map_new = graph_.keyframe_pose(last_keyframe_) * delta;
+  auto added = graph_.AddKeyframe(scan.end_s, T_map_new);
+  if (!added) return added.error();
+  const std::uint32_t id = *added;
+  sequence_[id] = next_sequence_++;
+  keyframe_odometry_[id] = T_odom_now;
+  if (have_keyframe_) {
+    if (across_gap) ++stats_.odometry_gap_keyframes;
+    static_cast<void>(graph_.AddRelativePose(last_keyframe_, id, delta,
+                                             OdometryInformation(delta, across_gap),
+                                             RelativePoseKind::kOdometry));
+    if (matched) {
+      static_cast<void>(graph_.AddRelativePose(last_keyframe_, id, T_last_new, match_information,
+                                               RelativePoseKind::kScanMatch));
+    }
+    path_m_ += delta.translation().norm();
+  }
+  // Planes.
+  static_cast<void>(extractor_.Extract(down_.span(), normals_.span(), config_.planes, planes_));
+  static_cast<void>(planes_mapper_.Associate(graph_, id, planes_.span()));
+  Stage(observer, MapperStage::kPlanes);
+  // Stored cloud and descriptor.
+  if (voxel_.Downsample(down_.span(), config_.store_voxel_m, stored_)) {
+    static_cast<void>(clouds_.Put(id, sequence_[id], stored_.span()));
+    static_cast<void>(loops_.AddKeyframe(id, sequence_[id], path_m_, stored_.span()));
+  }
+  // Free space from the full-resolution sweep, with the estimate as it is now.
+  {
+    const Eigen::Isometry3d T_map_base = graph_.keyframe_pose(id);
+    const Eigen::Affine3f T = T_map_base.cast<float>();
+    world_points_.clear();
+    for (const Eigen::Vector3f& p : filtered_)
+      static_cast<void>(world_points_.try_push_back(T * p));
+    grid_.Integrate((T_map_base * config_.T_base_lidar).translation().cast<float>(),
+                    world_points_.span(),
+                    static_cast<float>(T_map_base.translation().z() - config_.base_height_m));
+  }
+  Stage(observer, MapperStage::kFreeSpace);
+  static_cast<void>(graph_.Solve(SolveKind::kLocal));
+  Stage(observer, MapperStage::kLocalSolve);
+  const auto store = [this](std::uint32_t k, std::uint64_t s) { return clouds_.Get(k, s); };
+  const bool loop = loops_.Detect(graph_, id, down_.span(), covariances_.span(), store);
+  Stage(observer, MapperStage::kLoopClosure);
+  ++keyframes_since_full_;
+  if (loop || keyframes_since_full_ >= config_.full_solve_every_keyframes) {
+    static_cast<void>(graph_.Solve(SolveKind::kFull));
+    ++stats_.full_solves;
+    if (loop && loops_.RejectIfContradicted(graph_)) {
+      static_cast<void>(graph_.Solve(SolveKind::kFull));  // undo its pull
+      ++stats_.full_solves;
+    } else if (loop) {
+      ++stats_.loop_closures;
+    }
+    keyframes_since_full_ = 0;
+  }
+  Stage(observer, MapperStage::kFullSolve);
+  if (++keyframes_since_rooms_ >= config_.room_update_every_keyframes) {
+    keyframes_since_rooms_ = 0;
+    static_cast<void>(rooms_.Update(grid_, planes_mapper_, graph_));
+  }
+  Stage(observer, MapperStage::kRooms);
+  have_keyframe_ = true;
+  last_keyframe_ = id;
+  last_odometry_ = T_odom_now;
+  T_map_odom_ = graph_.keyframe_pose(id) * T_odom_now.inverse();
+  ++stats_.keyframes;
+  return ScanOutcome::kKeyframe;
+}
+
+Status LocalMapper::Finish() {
+  if (!have_keyframe_) return Ok();
+  static_cast<void>(rooms_.Update(grid_, planes_mapper_, graph_));
+  auto report = graph_.Solve(SolveKind::kFull);
+  if (!report) return report.error();
+  ++stats_.full_solves;
+  T_map_odom_ = graph_.keyframe_pose(last_keyframe_) * last_odometry_.inverse();
+  return Ok();
+}
+
+}  // namespace msgraphs::core

@@ -1,0 +1,284 @@
+// SPDX-License-Identifier: MIT
+// The local S-Graph front end: odometry buffer, keyframe cloud store, plane association, the
+// Hessian-shaped information, and the whole mapper on a synthetic room walked with biased
+// odometry; bad input counted; no allocation on the per-scan path.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "alloc_counter.hpp"
+#include "msgraphs/core/geometry/se3.hpp"
+#include "msgraphs/core/slam/keyframe_cloud_store.hpp"
+#include "msgraphs/core/slam/local_mapper.hpp"
+#include "msgraphs/core/slam/loop_closer.hpp"
+#include "msgraphs/core/slam/odometry_buffer.hpp"
+#include "msgraphs/core/slam/plane_mapper.hpp"
+#include "synthetic_clouds.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+Eigen::Isometry3d Pose(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = RotZ(yaw);
+  T.translation() << x, y, 0;
+  return T;
+}
+
+TEST(OdometryBuffer, InterpolatesAndRefusesDisorder) {
+  OdometryBuffer b;
+  b.Init(8, 0.15);
+  ASSERT_TRUE(b.Add(1.0, Pose(0, 0, 0)));
+  ASSERT_TRUE(b.Add(1.1, Pose(1, 0, 0.2)));
+  auto mid = b.At(1.05);
+  ASSERT_TRUE(mid);
+  EXPECT_NEAR(mid->T_odom_base.translation().x(), 0.5, 1e-9);
+  EXPECT_FALSE(mid->across_gap);
+  EXPECT_EQ(b.At(1.2).error().code, Errc::kWouldBlock);
+  EXPECT_EQ(b.At(0.9).error().code, Errc::kNotFound);
+  EXPECT_EQ(b.Add(1.1, Pose(2, 0, 0)).error().code, Errc::kOutOfOrder);  // duplicate
+  EXPECT_EQ(b.Add(1.0, Pose(2, 0, 0)).error().code, Errc::kOutOfOrder);  // backwards
+  Eigen::Isometry3d nan = Pose(0, 0, 0);
+  nan.translation().y() = std::nan("");
+  EXPECT_EQ(b.Add(1.2, nan).error().code, Errc::kInvalidArgument);
+  // A gap: the odometry stopped for half a second.
+  ASSERT_TRUE(b.Add(1.6, Pose(2, 0, 0.2)));
+  EXPECT_TRUE(b.At(1.3)->across_gap);
+  EXPECT_EQ(b.stats().out_of_order, 2u);
+  EXPECT_EQ(b.stats().invalid, 1u);
+  // Full: the oldest go.
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(b.Add(2.0 + i * 0.01, Pose(3, 0, 0)));
+  EXPECT_EQ(b.size(), 8u);
+  EXPECT_EQ(b.stats().overwritten, 5u);
+  EXPECT_EQ(b.At(1.05).error().code, Errc::kNotFound);
+}
+
+TEST(KeyframeCloudStore, EvictsTheOldestAndTellsReusedKeysApart) {
+  KeyframeCloudStore s;
+  s.Init(4, 100);
+  const std::vector<Eigen::Vector3f> forty(40, Eigen::Vector3f(1, 2, 3));
+  ASSERT_TRUE(s.Put(0, 1, forty));
+  ASSERT_TRUE(s.Put(1, 2, forty));
+  EXPECT_EQ(s.Get(0, 1).size(), 40u);
+  EXPECT_TRUE(s.Get(0, 7).empty());  // another owner of key 0
+  ASSERT_TRUE(s.Put(2, 3, forty));   // wraps: evicts key 0 only
+  EXPECT_TRUE(s.Get(0, 1).empty());
+  EXPECT_EQ(s.Get(1, 2).size(), 40u);
+  EXPECT_EQ(s.Get(2, 3).size(), 40u);
+  EXPECT_EQ(s.evicted(), 1u);
+  EXPECT_LE(s.used_points(), 100u);
+  EXPECT_EQ(s.peak_points(), 80u);
+  const std::vector<Eigen::Vector3f> huge(101, Eigen::Vector3f::Zero());
+  EXPECT_EQ(s.Put(3, 4, huge).error().code, Errc::kCapacityExceeded);
+  EXPECT_EQ(s.Put(9, 4, forty).error().code, Errc::kInvalidArgument);
+}
+
+ExtractedPlane Wall(const Eigen::Vector3d& n, double d, double u_min, double u_max) {
+  ExtractedPlane p;
+  p.kind = std::fabs(n.z()) > 0.9 ? PlaneKind::kHorizontal : PlaneKind::kVertical;
+  p.normal = n.normalized();
+  p.d = d;
+  p.basis_u = p.kind == PlaneKind::kVertical
+                  ? Eigen::Vector3d(-p.normal.y(), p.normal.x(), 0).normalized()
+                  : Eigen::Vector3d::UnitX();
+  p.basis_v = p.normal.cross(p.basis_u);
+  p.covariance = Eigen::Vector3d(1e-5, 1e-5, 1e-5).asDiagonal();
+  p.centroid = -d * p.normal + p.basis_u * (0.5 * (u_min + u_max));
+  p.u_min = u_min;
+  p.u_max = u_max;
+  p.z_min = -0.4;
+  p.z_max = 2.0;
+  p.inliers = 500;
+  return p;
+}
+
+TEST(PlaneMapper, AssociatesBySideAndExtentNotJustByLine) {
+  SGraph g;
+  ASSERT_TRUE(g.Init({}));
+  PlaneMapper m;
+  ASSERT_TRUE(m.Init(64, {}));
+  const std::uint32_t k0 = *g.AddKeyframe(0, Pose(0, 0, 0));
+  // A wall 2 m ahead (x = 2, seen facing -x), two collinear pieces 3 m apart along it, a
+  // furniture face, and the floor.
+  const Eigen::Vector3d facing(-1, 0, 0);
+  std::vector<ExtractedPlane> planes{Wall(facing, 2.0, -1.0, 1.0), Wall(facing, 2.0, 4.0, 6.0),
+                                     Wall(facing, 1.0, 0.0, 0.3),
+                                     Wall(Eigen::Vector3d::UnitZ(), 0.5, -1, 1)};
+  ASSERT_TRUE(m.Associate(g, k0, planes));
+  EXPECT_EQ(g.plane_slots(), 3u);  // two wall pieces and the floor
+  EXPECT_EQ(m.stats().furniture, 1u);
+  // One metre on, the same wall is 1 m away and its first piece extends: it associates.
+  const std::uint32_t k1 = *g.AddKeyframe(1, Pose(1, 0, 0));
+  ASSERT_TRUE(g.AddRelativePose(k0, k1, Pose(1, 0, 0), Matrix6d::Identity() * 1e4,
+                                RelativePoseKind::kOdometry));
+  std::vector<ExtractedPlane> again{Wall(facing, 1.0, -2.0, 0.5),
+                                    Wall(Eigen::Vector3d::UnitZ(), 0.5, -1, 1)};
+  ASSERT_TRUE(m.Associate(g, k1, again));
+  EXPECT_EQ(g.plane_slots(), 3u);
+  EXPECT_EQ(m.stats().associated, 2u);
+  EXPECT_EQ(g.plane(0).observations, 2u);
+  EXPECT_EQ(g.plane(2).observations, 2u);  // the floor: horizontal planes associate too
+  // The other face of that wall (seen from beyond it, facing +x) is never the same landmark.
+  const std::uint32_t k2 = *g.AddKeyframe(2, Pose(3, 0, 0));
+  ASSERT_TRUE(g.AddRelativePose(k1, k2, Pose(2, 0, 0), Matrix6d::Identity() * 1e4,
+                                RelativePoseKind::kOdometry));
+  std::vector<ExtractedPlane> behind{Wall(Eigen::Vector3d::UnitX(), 0.88, -1.0, 1.0)};
+  ASSERT_TRUE(m.Associate(g, k2, behind));
+  EXPECT_EQ(g.plane_slots(), 4u);
+  // Its extent is what room detection sees.
+  BoundedVector<MapWall> walls(16);
+  BoundedVector<std::uint32_t> ids(16);
+  m.MapWalls(g, 2, walls, ids);
+  ASSERT_EQ(walls.size(), 1u);
+  EXPECT_EQ(ids[0], 0u);
+  EXPECT_NEAR(std::fabs(walls[0].d), 2.0, 1e-6);
+  EXPECT_NEAR(std::min(walls[0].a.y(), walls[0].b.y()), -1.0, 1e-6);
+  EXPECT_NEAR(std::max(walls[0].a.y(), walls[0].b.y()), 2.0, 1e-6);  // the union of both sightings
+}
+
+TEST(LoopCloser, InformationKeepsTheHessiansShape) {
+  Matrix6d H = Matrix6d::Identity();
+  H.diagonal() << 400, 400, 4, 1000, 1000, 1000;  // weak along z: a corridor-like degeneracy
+  const Matrix6d info = InformationFromHessian(H, 0.02);
+  EXPECT_NEAR(1.0 / std::sqrt(info(0, 0)), 0.02, 1e-4);
+  EXPECT_GT(1.0 / std::sqrt(info(2, 2)), 0.15);  // stays weak
+  Matrix6d bad = H;
+  bad(0, 0) = std::nan("");
+  EXPECT_TRUE(InformationFromHessian(bad, 0.02).isApprox(Matrix6d::Identity() / (0.02 * 0.02)));
+}
+
+// ---- the whole front end on a synthetic room -----------------------------------------------
+
+constexpr double kSx = 10.0, kSy = 8.0, kSz = 3.0;
+
+// A scan of the box room taken by a lidar 0.8 m above the floor at T_world_base.
+std::vector<Eigen::Vector3f> ScanAt(const Eigen::Isometry3d& T_world_base,
+                                    const LocalMapperConfig& config,
+                                    std::uint32_t seed) {
+  const Eigen::Isometry3d T_lidar_world = (T_world_base * config.T_base_lidar).inverse();
+  return test::BoxRoom(kSx, kSy, kSz, 20000, 0.01, seed, T_lidar_world);
+}
+
+// The true path (base at 0.5 m) inside the room and odometry with 5 % scale error and yaw drift.
+struct Walk {
+  std::vector<Eigen::Isometry3d> truth, odometry;
+  Walk() {
+    Eigen::Isometry3d odo = Eigen::Isometry3d::Identity();
+    for (int i = 0; i < 30; ++i) {
+      const double a = 2 * std::numbers::pi * i / 15.0;
+      Eigen::Isometry3d T =
+          Pose(5 + 2.5 * std::cos(a), 4 + 2.0 * std::sin(a), a + std::numbers::pi / 2);
+      T.translation().z() = 0.5;
+      if (i == 0) {
+        odo = T;
+      } else {
+        Eigen::Isometry3d delta = truth.back().inverse() * T;
+        delta.translation() *= 1.05;
+        delta.linear() = RotZ(0.01) * delta.linear();
+        odo = odo * delta;
+      }
+      truth.push_back(T);
+      odometry.push_back(odo);
+    }
+  }
+};
+
+// A mapper sized for the synthetic room: 20,000-point scans, a small grid around the room.
+LocalMapperConfig SmallConfig(std::size_t keyframes, int grid_cells) {
+  LocalMapperConfig config;
+  config.max_scan_points = 25000;
+  config.cloud_store_points = keyframes * 6000;
+  config.graph.max_keyframes = keyframes;
+  config.graph.max_factors = keyframes * 64;
+  config.grid.width = config.grid.height = grid_cells;
+  // Grid centred on the room (10 x 8 m, corner at the origin).
+  config.grid.origin_m = Eigen::Vector2f(5.0f, 4.0f) -
+                         Eigen::Vector2f::Constant(0.05f * static_cast<float>(grid_cells));
+  return config;
+}
+
+TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
+  const LocalMapperConfig config = SmallConfig(64, 256);
+  LocalMapper mapper;
+  ASSERT_TRUE(mapper.Init(config));
+  const Walk walk;
+  std::vector<float> times(20000, 0.1f);  // every point taken at the end of the sweep
+  double worst_odometry = 0;
+  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
+    const double t = 10.0 + static_cast<double>(i);
+    // The odometry frame starts at the first true pose's odometry reading.
+    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
+    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
+    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
+    auto outcome = mapper.AddScan({points, times, t - 0.1, t});
+    ASSERT_TRUE(outcome);
+    EXPECT_EQ(*outcome, ScanOutcome::kKeyframe);
+    worst_odometry = std::max(
+        worst_odometry, (walk.odometry[i].translation() - walk.truth[i].translation()).norm());
+  }
+  ASSERT_TRUE(mapper.Finish());
+  const SGraph& g = mapper.graph();
+  ASSERT_EQ(g.stats().keyframes, walk.truth.size());
+  // The map frame is the first odometry pose (= the first true pose here).
+  double worst = 0;
+  for (std::uint32_t k = 0; k < g.keyframe_slots(); ++k) {
+    const auto i = static_cast<std::size_t>(g.keyframe_stamp(k) - 10.0 + 0.5);
+    worst =
+        std::max(worst, (g.keyframe_pose(k).translation() - walk.truth[i].translation()).norm());
+  }
+  EXPECT_GT(worst_odometry, 0.5);
+  EXPECT_LT(worst, 0.05);
+  EXPECT_GT(mapper.stats().scan_match_accepted, 25u);
+  // Four walls, the floor and the ceiling; one four-wall room at the room's centre.
+  std::size_t walls = 0, floors = 0;
+  for (std::uint32_t p = 0; p < g.plane_slots(); ++p) {
+    const MapPlane plane = g.plane(p);
+    if (plane.observations < 3) continue;
+    walls += plane.plane_class == PlaneClass::kWall ? 1u : 0u;
+    floors += plane.plane_class == PlaneClass::kFloor ? 1u : 0u;
+  }
+  EXPECT_EQ(walls, 4u);
+  EXPECT_EQ(floors, 1u);
+  ASSERT_EQ(g.stats().rooms, 1u);
+  EXPECT_EQ(g.room(0).shape, RoomShape::kFourWall);
+  EXPECT_LT((g.room(0).centre - Eigen::Vector2d(5, 4)).norm(), 0.05);
+  EXPECT_TRUE(g.has_floor());
+}
+
+TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {
+  const LocalMapperConfig config = SmallConfig(32, 128);
+  LocalMapper mapper;
+  auto init = mapper.Init(config);
+  ASSERT_TRUE(init) << init.error().detail;
+  const auto points = ScanAt(Pose(5, 4, 0) * Eigen::Translation3d(0, 0, 0.5), config, 1);
+  std::vector<float> times(points.size(), 0.1f);
+  // Before any odometry: counted, not a keyframe.
+  EXPECT_EQ(*mapper.AddScan({points, times, 0.9, 1.0}), ScanOutcome::kNoOdometry);
+  // Points and times of different lengths.
+  EXPECT_FALSE(mapper.AddScan({points, std::span(times).first(10), 0.9, 1.0}));
+  ASSERT_TRUE(mapper.AddOdometry(0.5, Eigen::Isometry3d::Identity()));
+  ASSERT_TRUE(mapper.AddOdometry(1.05, Eigen::Isometry3d::Identity()));
+  EXPECT_EQ(*mapper.AddScan({points, times, 0.9, 1.0}), ScanOutcome::kKeyframe);
+  // Standing still: every further scan is not a keyframe, and that path allocates nothing.
+  test::AllocationScope scope;
+  for (int i = 0; i < 50; ++i) {
+    const double t = 1.1 + 0.1 * i;
+    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, Eigen::Isometry3d::Identity()));
+    auto outcome = mapper.AddScan({points, times, t - 0.1, t});
+    ASSERT_TRUE(outcome);
+    EXPECT_EQ(*outcome, ScanOutcome::kNotKeyframe);
+  }
+  EXPECT_EQ(scope.allocations(), 0u);
+  EXPECT_EQ(mapper.stats().no_odometry, 1u);
+  EXPECT_EQ(mapper.stats().bad_scans, 1u);
+  LocalMapperConfig bad = config;
+  bad.keyframe_spacing_m = -1;
+  EXPECT_FALSE(LocalMapper().Init(bad));
+  bad = config;
+  bad.T_base_lidar.linear()(0, 0) = 2;
+  EXPECT_FALSE(LocalMapper().Init(bad));
+}
+
+}  // namespace
+}  // namespace msgraphs::core

@@ -1,0 +1,372 @@
+// SPDX-License-Identifier: MIT
+// msgraphs_slam: one robot's recording (VLP-16 pcap + CAN candump) through the drivers and the
+// local S-Graph, as fast as possible in lock-step (odometry is fed up to each scan's end first).
+// Writes the keyframes (TUM, base frame), the encoder odometry at the same stamps (TUM), walls
+// and rooms (CSV), and prints per-stage timing percentiles, peak memory and, when the run
+// directory holds ground truth, the ATE of both against it and the walls and rooms found
+// against the world's truth.
+//
+//   msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] [--max-keyframes N]
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "msgraphs/core/slam/local_mapper.hpp"
+#include "msgraphs/drivers/can_odometry/candump_file.hpp"
+#include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
+#include "msgraphs/tools/recorded_scans.hpp"
+#include "msgraphs/tools/tum.hpp"
+#include "truth.hpp"
+#include "world.hpp"
+
+namespace {
+
+using namespace msgraphs;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Per-stage wall time of every keyframe.
+class Timer final : public core::StageObserver {
+ public:
+  void KeyframeStarted() override {
+    start_ = last_ = Clock::now();
+    active_ = true;
+  }
+  void StageEnded(core::MapperStage stage) override {
+    const auto now = Clock::now();
+    stages_[static_cast<std::size_t>(stage)].push_back(
+        std::chrono::duration<double, std::milli>(now - last_).count());
+    last_ = now;
+    if (stage == core::MapperStage::kRooms && active_) {
+      total_.push_back(std::chrono::duration<double, std::milli>(now - start_).count());
+      active_ = false;
+    }
+  }
+  static double Percentile(std::vector<double> v, double p) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    return v[static_cast<std::size_t>(
+        std::min<double>(static_cast<double>(v.size() - 1), p * static_cast<double>(v.size())))];
+  }
+  void Print() const {
+    std::printf("per keyframe [ms]        p50     p90     p99     max\n");
+    for (std::size_t s = 0; s < stages_.size(); ++s) {
+      const auto& v = stages_[s];
+      std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n",
+                  core::ToString(static_cast<core::MapperStage>(s)), Percentile(v, 0.5),
+                  Percentile(v, 0.9), Percentile(v, 0.99), Percentile(v, 1.0));
+    }
+    std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "total", Percentile(total_, 0.5),
+                Percentile(total_, 0.9), Percentile(total_, 0.99), Percentile(total_, 1.0));
+  }
+  const std::vector<double>& total() const { return total_; }
+
+ private:
+  std::array<std::vector<double>, static_cast<std::size_t>(core::MapperStage::kCount)> stages_;
+  std::vector<double> total_;
+  Clock::time_point start_, last_;
+  bool active_ = false;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string run, out_dir;
+  int robot = 1;
+  bool markdown = false, verbose = false;
+  std::size_t max_keyframes = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--run" && i + 1 < argc)
+      run = argv[++i];
+    else if (a == "--robot" && i + 1 < argc)
+      robot = std::atoi(argv[++i]);
+    else if (a == "--out" && i + 1 < argc)
+      out_dir = argv[++i];
+    else if (a == "--max-keyframes" && i + 1 < argc)
+      max_keyframes = static_cast<std::size_t>(std::atol(argv[++i]));
+    else if (a == "--markdown")
+      markdown = true;
+    else if (a == "--verbose")
+      verbose = true;
+    else {
+      std::fprintf(stderr,
+                   "usage: msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] "
+                   "[--max-keyframes N]\n");
+      return 2;
+    }
+  }
+  const fs::path dir = fs::path(run) / ("robot" + std::to_string(robot));
+  if (run.empty() || !fs::exists(dir / "velodyne.pcap") || !fs::exists(dir / "odometry.log")) {
+    std::fprintf(stderr, "slam: %s needs velodyne.pcap and odometry.log\n", dir.c_str());
+    return 2;
+  }
+  core::LocalMapperConfig config;
+  if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;
+  std::string world_error;
+  std::optional<sim::World> world;
+  if (fs::exists(fs::path(run) / "world.world"))
+    world = sim::LoadWorld((fs::path(run) / "world.world").string(), world_error);
+  core::LocalMapper mapper;
+  if (auto s = mapper.Init(config); !s) {
+    std::fprintf(stderr, "slam: %s\n", s.error().detail);
+    return 1;
+  }
+  rusage after_init{};
+  getrusage(RUSAGE_SELF, &after_init);
+  auto scans = tools::RecordedScans::Open((dir / "velodyne.pcap").string());
+  auto candump = drivers::can_odometry::CandumpFileReader::Open((dir / "odometry.log").c_str());
+  if (!scans || !candump) {
+    std::fprintf(stderr, "slam: cannot open the recording in %s\n", dir.c_str());
+    return 1;
+  }
+  auto odometry = drivers::can_odometry::OdometryStream::Create({}).value();
+  drivers::can_odometry::CandumpLine line;
+  bool odometry_done = false;
+  auto feed_odometry_until = [&](double t) {
+    while (!odometry_done && mapper.odometry().newest_stamp() < t) {
+      auto next = candump->Next(line);
+      if (!next || !*next) {
+        odometry_done = true;
+        break;
+      }
+      if (!odometry.Add(line.frame, line.stamp)) continue;
+      const auto& p = odometry.pose();
+      const auto& P = p.T_odom_base;
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.linear() = Eigen::Quaterniond(P.qw, P.qx, P.qy, P.qz).normalized().toRotationMatrix();
+      T.translation() = Eigen::Vector3d(P.x_m, P.y_m, P.z_m);
+      static_cast<void>(mapper.AddOdometry(p.stamp.seconds_since_epoch(), T));
+    }
+  };
+  std::vector<Eigen::Vector3f> points;
+  std::vector<float> times;
+  Timer timer;
+  const auto t_start = Clock::now();
+  std::size_t scan_count = 0;
+  while (const drivers::velodyne::Scan* next = scans->Next()) {
+    const auto& scan = *next;
+    ++scan_count;
+    points.clear();
+    times.clear();
+    for (const auto& p : scan.points) {
+      points.emplace_back(p.x_m, p.y_m, p.z_m);
+      times.push_back(static_cast<float>(p.time_offset_ns * 1e-9));
+    }
+    core::LidarScanView view{points, times, scan.start_time.seconds_since_epoch(),
+                             scan.end_time.seconds_since_epoch()};
+    feed_odometry_until(view.end_s + 0.05);
+    const auto loops_before = mapper.loop_closer().stats().accepted;
+    const auto rejected_before = mapper.loop_closer().stats().rejected_after_solve;
+    static_cast<void>(mapper.AddScan(view, &timer));
+    const auto& l = mapper.loop_closer().stats();
+    if (verbose && l.accepted + l.rejected_after_solve != loops_before + rejected_before) {
+      std::printf(
+          "loop closure: keyframe %u to %u, fitness %.4f m^2, moved the estimate %.3f m%s\n",
+          l.last_to, l.last_from, l.last_fitness_m2, l.last_correction_m,
+          l.rejected_after_solve != rejected_before ? ": contradicted after the solve, removed"
+                                                    : "");
+    }
+  }
+  static_cast<void>(mapper.Finish());
+  const double seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
+
+  // Outputs.
+  const core::SGraph& graph = mapper.graph();
+  std::vector<tools::StampedPose> slam, encoders;
+  for (std::uint32_t k = 0; k < graph.keyframe_slots(); ++k) {
+    if (!graph.keyframe_active(k)) continue;
+    slam.push_back({graph.keyframe_stamp(k), graph.keyframe_pose(k)});
+    encoders.push_back({graph.keyframe_stamp(k), mapper.keyframe_odometry(k)});
+  }
+  auto by_time = [](const tools::StampedPose& a, const tools::StampedPose& b) { return a.t < b.t; };
+  std::sort(slam.begin(), slam.end(), by_time);
+  std::sort(encoders.begin(), encoders.end(), by_time);
+  if (!out_dir.empty()) {
+    fs::create_directories(out_dir);
+    static_cast<void>(tools::WriteTum((fs::path(out_dir) / "keyframes.tum").string(), slam));
+    static_cast<void>(
+        tools::WriteTum((fs::path(out_dir) / "odometry_keyframes.tum").string(), encoders));
+    std::ofstream walls(fs::path(out_dir) / "walls.csv");
+    walls << "id,class,nx,ny,nz,d,observations,x1,y1,x2,y2\n";
+    for (std::uint32_t i = 0; i < graph.plane_slots(); ++i) {
+      const core::MapPlane p = graph.plane(i);
+      const auto& e = mapper.plane_mapper().extent(i);
+      walls << i << ',' << static_cast<int>(p.plane_class) << ',' << p.normal.x() << ','
+            << p.normal.y() << ',' << p.normal.z() << ',' << p.d << ',' << p.observations << ','
+            << e.a.x() << ',' << e.a.y() << ',' << e.b.x() << ',' << e.b.y() << '\n';
+    }
+    std::ofstream rooms(fs::path(out_dir) / "rooms.csv");
+    rooms << "id,shape,x,y,wall0,wall1,wall2,wall3\n";
+    for (std::uint32_t i = 0; i < graph.room_slots(); ++i) {
+      const core::MapRoom r = graph.room(i);
+      if (!r.active) continue;
+      rooms << i << ',' << (r.shape == core::RoomShape::kFourWall ? "room" : "corridor") << ','
+            << r.centre.x() << ',' << r.centre.y() << ',' << r.walls[0] << ',' << r.walls[1] << ','
+            << r.walls[2] << ',' << r.walls[3] << '\n';
+    }
+  }
+  const auto truth = tools::ReadTum((dir / "ground_truth.tum").string());
+  const tools::AteResult ate_slam = tools::ComputeAte(slam, truth, 0.006),
+                         ate_odometry = tools::ComputeAte(encoders, truth, 0.006);
+  if (!out_dir.empty() && ate_slam.ok) {
+    // Per-keyframe error after the alignment, to see where an estimate went wrong.
+    std::ofstream errors(fs::path(out_dir) / "keyframe_errors.txt");
+    for (const tools::StampedPose& e : slam) {
+      if (const tools::StampedPose* t = tools::Nearest(truth, e.t, 0.006)) {
+        errors << std::fixed << e.t << ' '
+               << (ate_slam.T_truth_estimate * e.T.translation() - t->T.translation()).norm()
+               << '\n';
+      }
+    }
+  }
+
+  // Walls and rooms against the world (through the ATE alignment).
+  std::size_t walls_mapped = 0, walls_true = 0, rooms_mapped = 0, rooms_correct = 0,
+              rooms_visited = 0;
+  double wall_offset_sum = 0;
+  if (world && ate_slam.ok) {
+    const Eigen::Isometry3d& A = ate_slam.T_truth_estimate;
+    std::map<std::string, bool> room_matched, visited;
+    for (const tools::StampedPose& s : truth) {
+      if (const sim::Room* r = world->RoomAt(s.T.translation().head<2>(), 0)) visited[r->id] = true;
+    }
+    rooms_visited = visited.size();
+    for (std::uint32_t i = 0; i < graph.plane_slots(); ++i) {
+      const core::MapPlane p = graph.plane(i);
+      if (!p.active || p.plane_class != core::PlaneClass::kWall || p.observations < 2) continue;
+      ++walls_mapped;
+      const Eigen::Vector3d n = A.linear() * p.normal;
+      const auto& e = mapper.plane_mapper().extent(i);
+      const Eigen::Vector2d mid =
+          (A * Eigen::Vector3d(0.5 * (e.a.x() + e.b.x()), 0.5 * (e.a.y() + e.b.y()), 0)).head<2>();
+      double best = 1e9;
+      for (const sim::Wall& w : world->walls) {
+        // Both faces of the true wall: n pointing away from the wall, offset by half the thickness.
+        for (double side : {1.0, -1.0}) {
+          const Eigen::Vector2d fn = w.normal() * side;
+          const double fd = -fn.dot(w.start) - 0.5 * w.thickness_m;
+          if (fn.dot(n.head<2>().normalized()) < std::cos(5.0 * std::numbers::pi / 180.0)) continue;
+          const double along = (mid - w.start).dot(w.direction());
+          if (along < -0.5 || along > w.length() + 0.5) continue;
+          best = std::min(best, std::fabs(fn.dot(mid) + fd));
+        }
+      }
+      if (best < 0.10) {
+        ++walls_true;
+        wall_offset_sum += best;
+      }
+    }
+    for (std::uint32_t i = 0; i < graph.room_slots(); ++i) {
+      const core::MapRoom r = graph.room(i);
+      if (!r.active) continue;
+      ++rooms_mapped;
+      const Eigen::Vector2d c = (A * Eigen::Vector3d(r.centre.x(), r.centre.y(), 0)).head<2>();
+      const sim::Room* truth_room = world->RoomAt(c, 0);
+      if (truth_room != nullptr && !room_matched[truth_room->id]) {
+        room_matched[truth_room->id] = true;
+        ++rooms_correct;
+      }
+    }
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto gs = graph.stats();
+  const auto& ms = mapper.stats();
+  if (markdown) {
+    std::printf(
+        "| %s | %d | %zu | %.3f | %.3f | %zu / %zu | %zu / %zu (%zu visited) | %llu | %.0f | %.1f "
+        "|\n",
+        world ? world->name.c_str() : run.c_str(), robot, slam.size(), ate_odometry.rmse,
+        ate_slam.rmse, walls_true, walls_mapped, rooms_correct, rooms_mapped, rooms_visited,
+        static_cast<unsigned long long>(ms.loop_closures), Timer::Percentile(timer.total(), 0.5),
+        static_cast<double>(usage.ru_maxrss) / 1024.0);
+    return 0;
+  }
+  std::printf("robot %d: %zu scans, %zu keyframes, %.1f s (%.1f x real time)\n", robot, scan_count,
+              slam.size(), seconds,
+              static_cast<double>(scan_count) * 0.1 / std::max(1e-9, seconds));
+  std::printf(
+      "ATE RMSE (SE(3) Umeyama, %zu keyframes): S-Graph %.3f m (max %.3f), encoder odometry %.3f m "
+      "(max %.3f)\n",
+      ate_slam.poses, ate_slam.rmse, ate_slam.max, ate_odometry.rmse, ate_odometry.max);
+  std::printf(
+      "graph: %zu keyframes (peak %zu, %zu sparsified), %zu planes, %zu rooms, %zu floor; %zu "
+      "factors "
+      "(odometry %zu, scan matching %zu, loop %zu, sparsified %zu, plane %zu, room %zu, wall-wall "
+      "%zu, floor %zu)\n",
+      gs.keyframes, gs.keyframes_peak, gs.sparsified, gs.planes, gs.rooms, gs.floors, gs.factors,
+      gs.relative_factors[0], gs.relative_factors[1], gs.relative_factors[2],
+      gs.relative_factors[3], gs.plane_factors, gs.room_factors, gs.wall_wall_factors,
+      gs.floor_factors);
+  std::printf(
+      "refused: pose %llu, stamp %llu, information %llu, behind %llu, missing node %llu, capacity "
+      "%llu; solves %llu "
+      "(%llu at their limit, %llu undone)\n",
+      static_cast<unsigned long long>(gs.rejected_pose),
+      static_cast<unsigned long long>(gs.rejected_stamp),
+      static_cast<unsigned long long>(gs.rejected_information),
+      static_cast<unsigned long long>(gs.rejected_behind),
+      static_cast<unsigned long long>(gs.rejected_missing_node),
+      static_cast<unsigned long long>(gs.rejected_capacity),
+      static_cast<unsigned long long>(gs.solves),
+      static_cast<unsigned long long>(gs.solves_not_converged),
+      static_cast<unsigned long long>(gs.solves_undone));
+  std::printf(
+      "scan matching: %llu accepted; rejected fitness %llu, overlap %llu, diverged %llu, failed "
+      "%llu; odometry gaps at %llu keyframes\n",
+      static_cast<unsigned long long>(ms.scan_match_accepted),
+      static_cast<unsigned long long>(ms.scan_match_rejected_fitness),
+      static_cast<unsigned long long>(ms.scan_match_rejected_overlap),
+      static_cast<unsigned long long>(ms.scan_match_rejected_diverged),
+      static_cast<unsigned long long>(ms.scan_match_rejected_failed),
+      static_cast<unsigned long long>(ms.odometry_gap_keyframes));
+  const auto& ls = mapper.loop_closer().stats();
+  std::printf(
+      "loop closure: %llu queries, %llu candidates, %llu verified, %llu accepted (fitness %llu, "
+      "overlap %llu, not converged %llu, contradicted after the solve %llu rejected)\n",
+      static_cast<unsigned long long>(ls.queries), static_cast<unsigned long long>(ls.candidates),
+      static_cast<unsigned long long>(ls.verified), static_cast<unsigned long long>(ls.accepted),
+      static_cast<unsigned long long>(ls.rejected_fitness),
+      static_cast<unsigned long long>(ls.rejected_overlap),
+      static_cast<unsigned long long>(ls.rejected_not_converged),
+      static_cast<unsigned long long>(ls.rejected_after_solve));
+  const auto& ps = mapper.plane_mapper().stats();
+  const auto& rs = mapper.room_mapper().stats();
+  std::printf(
+      "planes: %llu associated, %llu created, %llu furniture faces skipped, %llu refused; rooms: "
+      "%llu updates, %llu detections, %llu created, %llu matched, %llu corridors completed, %llu "
+      "wall-wall\n",
+      static_cast<unsigned long long>(ps.associated), static_cast<unsigned long long>(ps.created),
+      static_cast<unsigned long long>(ps.furniture), static_cast<unsigned long long>(ps.rejected),
+      static_cast<unsigned long long>(rs.updates), static_cast<unsigned long long>(rs.detections),
+      static_cast<unsigned long long>(rs.created), static_cast<unsigned long long>(rs.matched),
+      static_cast<unsigned long long>(rs.upgraded), static_cast<unsigned long long>(rs.wall_wall));
+  if (world) {
+    std::printf(
+        "against the world: %zu of %zu mapped walls are true faces (mean offset %.3f m); %zu of "
+        "%zu rooms are distinct true rooms (%zu rooms visited)\n",
+        walls_true, walls_mapped,
+        wall_offset_sum / std::max<double>(1, static_cast<double>(walls_true)), rooms_correct,
+        rooms_mapped, rooms_visited);
+  }
+  std::printf(
+      "memory: graph stores %.1f MB, cloud store peak %zu of %zu points, local map peak %zu "
+      "points, RSS after Init %.1f MB, peak RSS %.1f MB\n",
+      static_cast<double>(gs.store_bytes) / 1e6, mapper.clouds().peak_points(),
+      mapper.clouds().capacity_points(), ms.local_map_points_peak,
+      static_cast<double>(after_init.ru_maxrss) / 1024.0,
+      static_cast<double>(usage.ru_maxrss) / 1024.0);
+  timer.Print();
+  return 0;
+}
