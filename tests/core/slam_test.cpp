@@ -19,12 +19,7 @@
 namespace msgraphs::core {
 namespace {
 
-Eigen::Isometry3d Pose(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotZ(yaw);
-  T.translation() << x, y, 0;
-  return T;
-}
+Eigen::Isometry3d Pose(double x, double y, double yaw) { return test::PlanarPose(x, y, yaw); }
 
 TEST(OdometryBuffer, InterpolatesAndRefusesDisorder) {
   OdometryBuffer b;

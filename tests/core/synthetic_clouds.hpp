@@ -10,6 +10,14 @@
 
 namespace msgraphs::test {
 
+/// A pose on the floor plane: x, y and yaw.
+inline Eigen::Isometry3d PlanarPose(double x, double y, double yaw_rad) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() << x, y, 0;
+  return T;
+}
+
 inline std::vector<Eigen::Vector3f> BoxRoom(double sx, double sy, double sz, std::size_t n, double noise_m,
                                             std::uint32_t seed, const Eigen::Isometry3d& T = Eigen::Isometry3d::Identity(),
                                             bool with_ceiling = true) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "msgraphs/core/geometry/se3.hpp"
+#include "msgraphs/core/graph/distilled_graph.hpp"
 #include "s_graph_factors.hpp"
 
 namespace msgraphs::core {
@@ -515,6 +516,8 @@ Expected<std::uint32_t> SGraph::AddPlane(const Eigen::Vector3d& normal_map,
   p.d[0] = d_map / norm;
   p.info.plane_class = plane_class;
   p.info.active = true;
+  // A fixed basis of the plane for its information: horizontal u for walls (along the wall).
+  WallBasis(Eigen::Vector3d(p.n[0], p.n[1], p.n[2]), p.info.basis_u, p.info.basis_v);
   return static_cast<std::uint32_t>(m.plane_count++);
 }
 
@@ -573,6 +576,14 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
   m.factors[static_cast<std::size_t>(*slot)].id =
       m.problem->AddResidualBlock(cost, m.huber_plane.get(), k.q, k.t, p.n, p.d);
   ++m.stats.plane_factors;
+  // Information of this observation about the map plane: the Jacobian of the measurement
+  // coordinates (u_m.n_k, v_m.n_k, d_k) with respect to the map plane's (alpha, beta, delta_d),
+  // n_k = R^T n and d_k = d + n.t, at the keyframe's current estimate.
+  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d ru = T.linear().transpose() * p.info.basis_u, rv = T.linear().transpose() * p.info.basis_v;
+  J << z.basis_u.dot(ru), z.basis_u.dot(rv), 0, z.basis_v.dot(ru), z.basis_v.dot(rv), 0,
+      p.info.basis_u.dot(T.translation()), p.info.basis_v.dot(T.translation()), 1;
+  p.info.information += J.transpose() * information * J;
   ++p.info.observations;
   p.info.last_keyframe = keyframe;
   return Ok();

@@ -3,7 +3,7 @@
 // decoding, device clock, scan assembly), for the host tools that evaluate on recordings.
 #pragma once
 
-#include <optional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -17,10 +17,11 @@ namespace msgraphs::tools {
 
 class RecordedScans {
  public:
-  static std::optional<RecordedScans> Open(const std::string& pcap_path) {
+  /// nullptr when the file cannot be opened or is not a pcap.
+  static std::unique_ptr<RecordedScans> Open(const std::string& pcap_path) {
     auto reader = drivers::pcap::PcapFileReader::Open(pcap_path.c_str());
-    if (!reader) return std::nullopt;
-    return RecordedScans(std::move(*reader));
+    if (!reader) return nullptr;
+    return std::unique_ptr<RecordedScans>(new RecordedScans(std::move(*reader)));
   }
 
   /// The next complete sweep, or nullptr at the end of the file (incomplete sweeps are skipped).

@@ -79,6 +79,12 @@ struct PlaneMeasurement {
 struct MapPlane {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit; the side it was seen from
   double d = 0;
+  /// The plane's information from its observations, conditional on the keyframe estimates at
+  /// the time, over the minimal perturbation (alpha, beta, delta_d) along basis_u / basis_v (the
+  /// extractor's convention, in the map frame). Zero before the first observation.
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d basis_u = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d basis_v = Eigen::Vector3d::UnitZ();
   PlaneClass plane_class = PlaneClass::kWall;
   std::uint32_t observations = 0;
   std::uint32_t last_keyframe = 0;  ///< newest keyframe that observed it

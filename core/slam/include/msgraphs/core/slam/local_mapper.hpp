@@ -149,6 +149,11 @@ class LocalMapper {
   const LoopCloser& loop_closer() const { return loops_; }
   const OdometryBuffer& odometry() const { return odometry_; }
   const KeyframeCloudStore& clouds() const { return clouds_; }
+  /// A keyframe's stored cloud (base frame, store_voxel_m); empty when evicted or sparsified.
+  std::span<const Eigen::Vector3f> keyframe_cloud(std::uint32_t keyframe) const {
+    if (keyframe >= sequence_.size() || !graph_.keyframe_active(keyframe)) return {};
+    return clouds_.Get(keyframe, sequence_[keyframe]);
+  }
   const FreeSpaceGrid& grid() const { return grid_; }
   const LocalMapperConfig& config() const { return config_; }
 

@@ -1,0 +1,13 @@
+// SPDX-License-Identifier: MIT
+// CRC-32 (IEEE 802.3: reflected polynomial 0xEDB88320, init and final XOR 0xFFFFFFFF), the
+// check on our own wire messages. Table-driven; never allocates.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+namespace msgraphs {
+
+std::uint32_t Crc32(std::span<const std::uint8_t> bytes) noexcept;
+
+}  // namespace msgraphs

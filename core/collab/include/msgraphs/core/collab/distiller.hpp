@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Distillation (paper section V): the local S-Graph reduced to what other robots need: the
+// origin (this robot's map frame, implicit), walls with their covariances, rooms with their
+// walls, and the floor. Keyframes stay home.
+//
+// Versioned and incremental: each wall and room carries the graph version in which it last
+// changed by more than the resend thresholds, so the codec can send only what changed since
+// what a peer acknowledged. Sized at Init; Update allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/graph/distilled_graph.hpp"
+#include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/slam/plane_mapper.hpp"
+
+namespace msgraphs::core {
+
+struct DistillerConfig {
+  std::uint32_t min_wall_observations = 3;  ///< walls of a room are always included
+  double resend_distance_m = 0.01;          ///< a wall's offset or a room's centre moved this much
+  double resend_angle_rad = 0.0017;         ///< or a normal turned this much (0.1 degree)
+  double resend_covariance_ratio = 0.5;     ///< or a wall's uncertainty changed by this factor
+  std::size_t max_walls = 1024;
+  std::size_t max_rooms = 256;
+  Status Validate() const;
+};
+
+class Distiller {
+ public:
+  Status Init(std::uint16_t robot, std::size_t max_planes, const DistillerConfig& config);
+
+  /// Refreshes the distilled graph from the local one; true when something changed (the graph's
+  /// version then went up and the changed elements carry it).
+  bool Update(const SGraph& graph, const PlaneMapper& planes);
+
+  const DistilledGraph& graph() const { return out_; }
+
+ private:
+  DistillerConfig config_;
+  DistilledGraph out_;
+  std::vector<std::int32_t> wall_slot_;  // local plane id -> index in out_.walls, -1 if absent
+  std::vector<std::int32_t> room_slot_;  // local room id -> index in out_.rooms
+  std::vector<std::uint8_t> needed_;     // per local plane: a room uses it
+};
+
+}  // namespace msgraphs::core

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: MIT
+// Room matching between two robots (paper section VI-B) and the geometric consistency check
+// the paper lacks.
+//
+// - A received room descriptor whose Scan Context distance to one of ours is below SC_th (0.35)
+//   proposes a pair, with the yaw between the two room frames from the best column shift.
+// - Fine alignment: VGICP of the other robot's room cloud onto ours, seeded with that yaw (and,
+//   rooms being nearly symmetric, the three other quarter turns); accepted when the fitness
+//   (mean squared nearest-neighbour distance, m^2) is below ICP_th (0.07). The match is the
+//   transform between the two robots' map frames.
+// - Consistency: every accepted match between the same two robots proposes the same map-to-map
+//   transform if they are right. Pairs that agree (translation and yaw) form a graph; its
+//   maximum clique is kept and everything else is rejected. Identical rooms of a symmetric
+//   building each align perfectly but to different transforms, so they do not agree with the
+//   true matches. A clique smaller than `min_consistent` keeps nothing (one match alone cannot be
+//   checked).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "msgraphs/base/bounded_vector.hpp"
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/descriptors/scan_context.hpp"
+#include "msgraphs/core/graph/distilled_graph.hpp"
+#include "msgraphs/core/perception/covariances.hpp"
+#include "msgraphs/core/perception/kdtree.hpp"
+#include "msgraphs/core/registration/gaussian_voxel_map.hpp"
+#include "msgraphs/core/registration/vgicp.hpp"
+
+namespace msgraphs::core {
+
+struct RoomMatchConfig {
+  float sc_threshold = 0.35f;           ///< the paper's SC_th
+  double icp_fitness_threshold = 0.07;  ///< the paper's ICP_th, m^2
+  double vgicp_resolution_m = 0.5;
+  double consistency_translation_m = 0.3;
+  double consistency_yaw_rad = 0.05;
+  std::size_t min_consistent = 2;
+  std::size_t max_points = 60000;
+  VgicpConfig vgicp;
+  Status Validate() const;
+};
+
+/// One room of robot a matched with one room of robot b.
+struct RoomMatch {
+  std::uint16_t robot_a = 0, robot_b = 0;
+  std::uint32_t room_a = 0, room_b = 0;
+  float sc_distance = 1.0f;
+  double fitness_m2 = 0;
+  bool fine_aligned = false;
+  Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity();  ///< map b into map a
+};
+
+class RoomMatcher {
+ public:
+  Status Init(const RoomMatchConfig& config);
+
+  /// Aligns room b's cloud (its room frame) onto room a's, starting from `yaw_rad`
+  /// (p_a = Rz(yaw) p_b). Fills match.T_a_b from the room frames; kNotConverged / kDegenerate
+  /// when no seed aligns within ICP_th.
+  Status FineAlign(std::span<const Eigen::Vector3f> cloud_a,
+                   const Eigen::Isometry3d& T_mapa_rooma,
+                   std::span<const Eigen::Vector3f> cloud_b,
+                   const Eigen::Isometry3d& T_mapb_roomb,
+                   double yaw_rad,
+                   RoomMatch& match);
+
+  const RoomMatchConfig& config() const { return config_; }
+
+ private:
+  RoomMatchConfig config_;
+  KdTree tree_a_, tree_b_;
+  BoundedVector<Eigen::Vector3f> normals_;
+  BoundedVector<Eigen::Matrix3f> covariances_a_, covariances_b_;
+  GaussianVoxelMap map_a_;
+  Vgicp vgicp_;
+};
+
+/// Without fine alignment: the transform from the room frames and the Scan Context yaw alone.
+Eigen::Isometry3d MatchFromRoomFrames(const Eigen::Isometry3d& T_mapa_rooma,
+                                      const Eigen::Isometry3d& T_mapb_roomb,
+                                      double yaw_rad);
+
+/// Indices of the largest set of mutually consistent matches (all between the same two robots);
+/// empty when it is smaller than config.min_consistent. At most 64 matches are considered.
+std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
+                              const RoomMatchConfig& config,
+                              std::span<std::uint32_t> out);
+
+}  // namespace msgraphs::core

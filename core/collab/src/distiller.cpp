@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: MIT
+#include "msgraphs/core/collab/distiller.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+namespace msgraphs::core {
+
+Status DistillerConfig::Validate() const {
+  if (min_wall_observations < 1 || !(resend_distance_m > 0) || !(resend_angle_rad > 0) ||
+      !(resend_covariance_ratio > 0) || max_walls < 1 || max_rooms < 1) {
+    return Error{Errc::kInvalidConfig, "distiller: thresholds and capacities must be positive"};
+  }
+  return Ok();
+}
+
+Status Distiller::Init(std::uint16_t robot, std::size_t max_planes, const DistillerConfig& config) {
+  if (auto s = config.Validate(); !s) return s;
+  config_ = config;
+  out_.Init(config.max_walls, config.max_rooms);
+  out_.robot = robot;
+  wall_slot_.assign(max_planes, -1);
+  room_slot_.assign(config.max_rooms * 4, -1);
+  needed_.assign(max_planes, 0);
+  return Ok();
+}
+
+bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
+  const std::uint32_t next = out_.version + 1;
+  bool changed = false;
+  // Walls the rooms stand on are always shared.
+  std::fill(needed_.begin(), needed_.end(), 0);
+  for (std::uint32_t r = 0; r < graph.room_slots(); ++r) {
+    const MapRoom room = graph.room(r);
+    if (!room.active) continue;
+    for (std::int32_t w : room.walls) {
+      if (w >= 0 && static_cast<std::size_t>(w) < needed_.size())
+        needed_[static_cast<std::size_t>(w)] = 1;
+    }
+  }
+  for (std::uint32_t id = 0; id < graph.plane_slots() && id < wall_slot_.size(); ++id) {
+    const MapPlane p = graph.plane(id);
+    if (!p.active || p.plane_class != PlaneClass::kWall) continue;
+    if (p.observations < config_.min_wall_observations && needed_[id] == 0) continue;
+    Eigen::LLT<Eigen::Matrix3d> llt(p.information);
+    if (llt.info() != Eigen::Success) continue;  // not yet constrained in every direction
+    const Eigen::Matrix3d covariance = llt.solve(Eigen::Matrix3d::Identity());
+    const WallExtent& e = planes.extent(id);
+    DistilledWall* w = nullptr;
+    if (wall_slot_[id] < 0) {
+      if (out_.walls.size() == out_.walls.capacity()) continue;  // full: the rest waits (bounded)
+      out_.walls.push_back(DistilledWall{});
+      wall_slot_[id] = static_cast<std::int32_t>(out_.walls.size() - 1);
+      w = &out_.walls[out_.walls.size() - 1];
+      w->id = id;
+      w->version = 0;
+    } else {
+      w = &out_.walls[static_cast<std::size_t>(wall_slot_[id])];
+    }
+    const bool moved = w->version == 0 || std::fabs(w->d - p.d) > config_.resend_distance_m ||
+                       std::acos(std::min(1.0, w->normal.dot(p.normal))) > config_.resend_angle_rad;
+    const double trace_ratio = covariance.trace() / std::max(1e-300, w->covariance.trace());
+    const bool sharper =
+        std::fabs(std::log(trace_ratio)) > std::log(1.0 + config_.resend_covariance_ratio);
+    const bool grew = e.valid && ((w->a - e.a).norm() > 0.1 || (w->b - e.b).norm() > 0.1);
+    if (moved || sharper || grew) {
+      w->normal = p.normal;
+      w->d = p.d;
+      w->covariance = covariance;
+      if (e.valid) {
+        w->a = e.a;
+        w->b = e.b;
+      }
+      w->version = next;
+      changed = true;
+    }
+  }
+  for (std::uint32_t r = 0; r < graph.room_slots() && r < room_slot_.size(); ++r) {
+    const MapRoom room = graph.room(r);
+    if (!room.active) continue;
+    DistilledRoom d;
+    d.id = r;
+    d.shape = room.shape;
+    d.centre = room.centre;
+    bool complete = true;
+    for (std::size_t i = 0; i < 4; ++i) {
+      const std::int32_t w = room.walls[i];
+      d.walls[i] = w;
+      if (w >= 0 && (static_cast<std::size_t>(w) >= wall_slot_.size() ||
+                     wall_slot_[static_cast<std::size_t>(w)] < 0)) {
+        complete = false;
+      }
+    }
+    if (!complete) continue;  // its walls are not shareable yet
+    // Frame and size from the walls: x along walls[0]'s normal; sizes wall to wall.
+    auto line = [&](std::int32_t w, Eigen::Vector2d& n, double& off) {
+      const MapPlane p = graph.plane(static_cast<std::uint32_t>(w));
+      const double norm = p.normal.head<2>().norm();
+      n = p.normal.head<2>() / norm;
+      off = p.d / norm;
+    };
+    Eigen::Vector2d n0, n1;
+    double d0, d1;
+    line(room.walls[0], n0, d0);
+    line(room.walls[1], n1, d1);
+    d.yaw_rad = std::atan2(n0.y(), n0.x());
+    d.size_x_m = d0 + d1;
+    if (room.shape == RoomShape::kFourWall) {
+      Eigen::Vector2d n2, n3;
+      double d2, d3;
+      line(room.walls[2], n2, d2);
+      line(room.walls[3], n3, d3);
+      d.size_y_m = d2 + d3;
+    }
+    DistilledRoom* slot = nullptr;
+    if (room_slot_[r] < 0) {
+      if (out_.rooms.size() == out_.rooms.capacity()) continue;
+      out_.rooms.push_back(d);
+      room_slot_[r] = static_cast<std::int32_t>(out_.rooms.size() - 1);
+      slot = &out_.rooms[out_.rooms.size() - 1];
+      slot->version = 0;
+    } else {
+      slot = &out_.rooms[static_cast<std::size_t>(room_slot_[r])];
+    }
+    const bool differs = slot->version == 0 || slot->shape != d.shape || slot->walls != d.walls ||
+                         (slot->centre - d.centre).norm() > config_.resend_distance_m;
+    if (differs) {
+      *slot = d;
+      slot->version = next;
+      changed = true;
+    }
+  }
+  const bool has_floor = graph.has_floor();
+  if (has_floor && (!out_.has_floor || (out_.floor_centre - graph.floor_centre()).norm() >
+                                           config_.resend_distance_m)) {
+    out_.floor_centre = graph.floor_centre();
+    changed = true;
+  }
+  out_.has_floor = has_floor;
+  if (changed) out_.version = next;
+  return changed;
+}
+
+}  // namespace msgraphs::core

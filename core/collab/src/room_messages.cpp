@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+#include "msgraphs/core/collab/room_messages.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstring>
+
+#include "msgraphs/base/byte_order.hpp"
+#include "msgraphs/base/crc32.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+constexpr std::uint8_t kFormat = 1;
+constexpr std::size_t kDescriptorHeader = 4 + 1 + 2 + 4 + 4 + 1 + 1 + 4;  // 21
+constexpr std::size_t kCloudHeader = 4 + 1 + 1 + 2 + 4 + 4 + 4 + 4;       // 24
+
+void PutF32(std::uint8_t* p, float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, 4);
+  WriteU32Le(p, u);
+}
+float GetF32(const std::uint8_t* p) {
+  const std::uint32_t u = ReadU32Le(p);
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+bool MagicIs(std::span<const std::uint8_t> b, const char* m) {
+  return std::memcmp(b.data(), m, 4) == 0;
+}
+
+Status CheckCrc(std::span<const std::uint8_t> bytes, std::size_t header) {
+  if (bytes.size() < header + 4)
+    return Error{Errc::kMalformed, "room message: shorter than its header"};
+  const std::size_t body = bytes.size() - 4;
+  if (ReadU32Le(&bytes[body]) != Crc32(bytes.first(body)))
+    return Error{Errc::kChecksum, "room message: CRC mismatch"};
+  return Ok();
+}
+
+}  // namespace
+
+std::size_t RoomDescriptorEncodedSize(const ScanContext& d) {
+  return kDescriptorHeader + static_cast<std::size_t>(d.rings() * d.sectors()) + 4;
+}
+
+Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& h,
+                                           const ScanContext& d,
+                                           std::span<std::uint8_t> out) {
+  const std::size_t size = RoomDescriptorEncodedSize(d);
+  if (size > out.size())
+    return Error{Errc::kCapacityExceeded, "room descriptor: output buffer too small"};
+  std::uint8_t* p = out.data();
+  std::memcpy(p, "MSRD", 4);
+  p[4] = kFormat;
+  WriteU16Le(p + 5, h.robot);
+  WriteU32Le(p + 7, h.room);
+  WriteU32Le(p + 11, h.version);
+  p[15] = static_cast<std::uint8_t>(d.rings());
+  p[16] = static_cast<std::uint8_t>(d.sectors());
+  PutF32(p + 17, d.max_radius_m());
+  std::size_t at = kDescriptorHeader;
+  for (int r = 0; r < d.rings(); ++r) {
+    for (int s = 0; s < d.sectors(); ++s, ++at) {
+      const float cm = std::round(std::clamp(d.cell(r, s), 0.0f, 2.55f) * 100.0f);
+      p[at] = static_cast<std::uint8_t>(cm);
+    }
+  }
+  WriteU32Le(p + at, Crc32(out.first(at)));
+  return at + 4;
+}
+
+Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t> bytes,
+                                                    ScanContext& d) {
+  if (auto s = CheckCrc(bytes, kDescriptorHeader); !s) return s.error();
+  if (!MagicIs(bytes, "MSRD")) return Error{Errc::kMalformed, "room descriptor: bad magic"};
+  if (bytes[4] != kFormat) return Error{Errc::kUnsupported, "room descriptor: unknown format"};
+  RoomDescriptorHeader h;
+  h.robot = ReadU16Le(&bytes[5]);
+  h.room = ReadU32Le(&bytes[7]);
+  h.version = ReadU32Le(&bytes[11]);
+  const int rings = bytes[15], sectors = bytes[16];
+  const float radius = GetF32(&bytes[17]);
+  if (rings < 1 || sectors < 1 || rings > ScanContext::kMaxRings ||
+      sectors > ScanContext::kMaxSectors) {
+    return Error{Errc::kMalformed, "room descriptor: rings or sectors out of range"};
+  }
+  if (bytes.size() != kDescriptorHeader + static_cast<std::size_t>(rings * sectors) + 4) {
+    return Error{Errc::kMalformed, "room descriptor: length does not match rings x sectors"};
+  }
+  std::array<float, ScanContext::kMaxRings * ScanContext::kMaxSectors> cells{};
+  for (std::size_t i = 0; i < static_cast<std::size_t>(rings * sectors); ++i) {
+    cells[i] = static_cast<float>(bytes[kDescriptorHeader + i]) * 0.01f;
+  }
+  if (auto s = d.FromCells(
+          rings, sectors, radius,
+          std::span<const float>(cells.data(), static_cast<std::size_t>(rings * sectors)));
+      !s) {
+    return s.error();
+  }
+  return h;
+}
+
+std::size_t RoomCloudEncodedSize(CloudEncoding encoding, std::size_t points) {
+  return kCloudHeader + points * (encoding == CloudEncoding::kFloat32 ? 12u : 6u) + 4;
+}
+
+Expected<std::size_t> EncodeRoomCloud(const RoomCloudHeader& h,
+                                      std::span<const Eigen::Vector3f> points,
+                                      std::span<std::uint8_t> out) {
+  if (h.encoding != CloudEncoding::kFloat32 && h.encoding != CloudEncoding::kQuantised16) {
+    return Error{Errc::kInvalidArgument, "room cloud: unknown encoding"};
+  }
+  if (h.encoding == CloudEncoding::kQuantised16 && !(h.step_m > 0))
+    return Error{Errc::kInvalidArgument, "room cloud: step must be positive"};
+  const std::size_t size = RoomCloudEncodedSize(h.encoding, points.size());
+  if (size > out.size())
+    return Error{Errc::kCapacityExceeded, "room cloud: output buffer too small"};
+  std::uint8_t* p = out.data();
+  std::memcpy(p, "MSRC", 4);
+  p[4] = kFormat;
+  p[5] = static_cast<std::uint8_t>(h.encoding);
+  WriteU16Le(p + 6, h.robot);
+  WriteU32Le(p + 8, h.room);
+  WriteU32Le(p + 12, h.version);
+  PutF32(p + 16, h.step_m);
+  WriteU32Le(p + 20, static_cast<std::uint32_t>(points.size()));
+  std::size_t at = kCloudHeader;
+  for (const Eigen::Vector3f& q : points) {
+    for (int k = 0; k < 3; ++k) {
+      if (h.encoding == CloudEncoding::kFloat32) {
+        PutF32(p + at, q[k]);
+        at += 4;
+      } else {
+        const float units = std::round(q[k] / h.step_m);
+        if (!(std::fabs(units) <= 32767.0f))
+          return Error{Errc::kInvalidArgument, "room cloud: point beyond the quantised range"};
+        WriteU16Le(p + at, static_cast<std::uint16_t>(static_cast<std::int16_t>(units)));
+        at += 2;
+      }
+    }
+  }
+  WriteU32Le(p + at, Crc32(out.first(at)));
+  return at + 4;
+}
+
+Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
+                                          BoundedVector<Eigen::Vector3f>& points) {
+  points.clear();
+  if (auto s = CheckCrc(bytes, kCloudHeader); !s) return s.error();
+  if (!MagicIs(bytes, "MSRC")) return Error{Errc::kMalformed, "room cloud: bad magic"};
+  if (bytes[4] != kFormat) return Error{Errc::kUnsupported, "room cloud: unknown format"};
+  if (bytes[5] > 1) return Error{Errc::kMalformed, "room cloud: unknown encoding"};
+  RoomCloudHeader h;
+  h.encoding = static_cast<CloudEncoding>(bytes[5]);
+  h.robot = ReadU16Le(&bytes[6]);
+  h.room = ReadU32Le(&bytes[8]);
+  h.version = ReadU32Le(&bytes[12]);
+  h.step_m = GetF32(&bytes[16]);
+  const std::size_t count = ReadU32Le(&bytes[20]);
+  if (h.encoding == CloudEncoding::kQuantised16 && !(h.step_m > 0 && std::isfinite(h.step_m))) {
+    return Error{Errc::kMalformed, "room cloud: bad quantisation step"};
+  }
+  if (count > points.capacity())
+    return Error{Errc::kCapacityExceeded, "room cloud: more points than the receiver holds"};
+  if (bytes.size() != RoomCloudEncodedSize(h.encoding, count))
+    return Error{Errc::kMalformed, "room cloud: length does not match the point count"};
+  std::size_t at = kCloudHeader;
+  for (std::size_t i = 0; i < count; ++i) {
+    Eigen::Vector3f q;
+    for (int k = 0; k < 3; ++k) {
+      if (h.encoding == CloudEncoding::kFloat32) {
+        q[k] = GetF32(&bytes[at]);
+        at += 4;
+      } else {
+        q[k] = static_cast<float>(static_cast<std::int16_t>(ReadU16Le(&bytes[at]))) * h.step_m;
+        at += 2;
+      }
+    }
+    if (!q.allFinite()) {
+      points.clear();
+      return Error{Errc::kMalformed, "room cloud: point not finite"};
+    }
+    points.push_back(q);
+  }
+  return h;
+}
+
+}  // namespace msgraphs::core

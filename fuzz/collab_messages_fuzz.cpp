@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+// libFuzzer target: arbitrary bytes as another robot's message. The first byte picks the kind
+// (distilled graph, room descriptor, room cloud); the rest is the message body, to which the
+// correct CRC-32 is appended so that the parsers past the checksum are exercised (a wrong CRC
+// alone is rejected at once). Invariants: no crash; whatever decodes is finite, within the
+// receiver's capacity, with unit wall normals, and merges into a copy.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <vector>
+
+#include "msgraphs/base/byte_order.hpp"
+#include "msgraphs/base/crc32.hpp"
+#include "msgraphs/core/collab/distilled_codec.hpp"
+#include "msgraphs/core/collab/room_messages.hpp"
+
+using namespace msgraphs;
+using namespace msgraphs::core;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  std::vector<std::uint8_t> message(data + 1, data + size);
+  message.resize(message.size() + 4);
+  WriteU32Le(message.data() + message.size() - 4,
+             Crc32(std::span(message.data(), message.size() - 4)));
+  const std::span<const std::uint8_t> bytes(message);
+  switch (data[0] % 3) {
+    case 0: {
+      static DistilledGraph known, out;
+      static bool init = false;
+      if (!init) {
+        known.Init(64, 16);
+        out.Init(64, 16);
+        init = true;
+      }
+      if (!DecodeDistilled(bytes, out, &known)) break;
+      if (out.walls.size() > 64 || out.rooms.size() > 16) std::abort();
+      for (const DistilledWall& w : out.walls) {
+        if (!w.normal.allFinite() || std::fabs(w.normal.norm() - 1.0) > 1e-6 || !std::isfinite(w.d))
+          std::abort();
+      }
+      if (out.has_floor && !out.floor_centre.allFinite()) std::abort();
+      static_cast<void>(ApplyDistilled(out, known));
+      if (known.walls.size() > known.walls.capacity()) std::abort();
+      break;
+    }
+    case 1: {
+      ScanContext sc;
+      if (!DecodeRoomDescriptor(bytes, sc)) break;
+      for (int r = 0; r < sc.rings(); ++r) {
+        for (int s = 0; s < sc.sectors(); ++s) {
+          if (!std::isfinite(sc.cell(r, s))) std::abort();
+        }
+      }
+      break;
+    }
+    default: {
+      static BoundedVector<Eigen::Vector3f> points(4096);
+      if (!DecodeRoomCloud(bytes, points)) break;
+      for (const Eigen::Vector3f& p : points) {
+        if (!p.allFinite()) std::abort();
+      }
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,384 @@
+// SPDX-License-Identifier: MIT
+// The multi-robot pieces: the distilled graph's wire encoding (round trip, deltas, every kind of
+// malformed input), room descriptor and room cloud messages, the consistency check against a
+// planted symmetric mismatch, fine alignment of two views of a room, and the collaborative
+// graph recovering another robot's origin.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "msgraphs/base/byte_order.hpp"
+#include "msgraphs/base/crc32.hpp"
+#include "msgraphs/core/collab/distilled_codec.hpp"
+#include "msgraphs/core/collab/distiller.hpp"
+#include "msgraphs/core/collab/room_matcher.hpp"
+#include "msgraphs/core/collab/room_messages.hpp"
+#include "msgraphs/core/geometry/se3.hpp"
+#include "msgraphs/core/graph/collaborative_graph.hpp"
+#include "synthetic_clouds.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+Eigen::Isometry3d Planar(double x, double y, double yaw) { return test::PlanarPose(x, y, yaw); }
+
+// A 6 x 4 m room centred at (cx, cy), rotated by yaw, in one robot's map: four walls and the room.
+void AddRoom(DistilledGraph& g,
+             std::uint32_t first_wall,
+             std::uint32_t room_id,
+             const Eigen::Isometry3d& T_map_room,
+             std::uint32_t version) {
+  const double hx = 3, hy = 2;
+  const Eigen::Vector3d ex = T_map_room.linear().col(0), ey = T_map_room.linear().col(1);
+  const Eigen::Vector3d c = T_map_room.translation();
+  const std::pair<Eigen::Vector3d, double> faces[4] = {{ex, hx}, {-ex, hx}, {ey, hy}, {-ey, hy}};
+  DistilledRoom room;
+  room.id = room_id;
+  room.version = version;
+  room.centre = c.head<2>();
+  room.yaw_rad = std::atan2(ex.y(), ex.x());
+  room.size_x_m = 2 * hx;
+  room.size_y_m = 2 * hy;
+  for (int i = 0; i < 4; ++i) {
+    DistilledWall w;
+    w.id = first_wall + static_cast<std::uint32_t>(i);
+    w.version = version;
+    w.normal = faces[i].first;
+    w.d = -w.normal.dot(c - w.normal * faces[i].second);
+    w.covariance = Eigen::Vector3d(1e-4, 1e-4, 4e-4).asDiagonal();
+    w.a = (c - w.normal * faces[i].second).head<2>();
+    w.b = w.a + Eigen::Vector2d(1, 0);
+    g.walls.push_back(w);
+    room.walls[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(w.id);
+  }
+  g.rooms.push_back(room);
+}
+
+DistilledGraph SampleGraph() {
+  DistilledGraph g;
+  g.Init(16, 4);
+  g.robot = 2;
+  g.version = 5;
+  g.has_floor = true;
+  g.floor_centre = {1.5, -2.0};
+  AddRoom(g, 10, 1, Planar(2, 3, 0.3), 3);
+  AddRoom(g, 20, 2, Planar(9, 3, 0.3), 5);
+  return g;
+}
+
+TEST(DistilledCodec, RoundTripsAndSendsOnlyWhatChanged) {
+  const DistilledGraph g = SampleGraph();
+  std::vector<std::uint8_t> buffer(4096);
+  auto n = EncodeDistilled(g, 0, buffer);
+  ASSERT_TRUE(n);
+  EXPECT_EQ(*n, DistilledEncodedSize(g, 0));
+  EXPECT_EQ(*n, kDistilledHeaderBytes + 8 + 8 * kDistilledWallBytes + 2 * kDistilledRoomBytes + 4);
+  DistilledGraph out;
+  out.Init(16, 4);
+  auto delta = DecodeDistilled(std::span(buffer.data(), *n), out);
+  ASSERT_TRUE(delta);
+  EXPECT_EQ(delta->since, 0u);
+  EXPECT_EQ(out.robot, 2);
+  EXPECT_EQ(out.version, 5u);
+  ASSERT_EQ(out.walls.size(), 8u);
+  ASSERT_EQ(out.rooms.size(), 2u);
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(out.walls[i].id, g.walls[i].id);
+    EXPECT_LT((out.walls[i].normal - g.walls[i].normal).norm(), 1e-6);
+    EXPECT_NEAR(out.walls[i].d, g.walls[i].d, 1e-5);
+    EXPECT_TRUE(out.walls[i].covariance.isApprox(g.walls[i].covariance, 1e-6));
+  }
+  EXPECT_EQ(out.rooms[1].walls, g.rooms[1].walls);
+  EXPECT_NEAR(out.rooms[1].yaw_rad, 0.3, 1e-6);
+  // Since version 3, only the second room and its walls travel; they may refer to known walls.
+  auto d = EncodeDistilled(g, 3, buffer);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(*d, kDistilledHeaderBytes + 8 + 4 * kDistilledWallBytes + kDistilledRoomBytes + 4);
+  DistilledGraph copy;
+  copy.Init(16, 4);
+  ASSERT_TRUE(ApplyDistilled(out, copy));
+  DistilledGraph delta_only;
+  delta_only.Init(16, 4);
+  ASSERT_TRUE(DecodeDistilled(std::span(buffer.data(), *d), delta_only, &copy));
+  EXPECT_EQ(delta_only.walls.size(), 4u);
+  ASSERT_TRUE(ApplyDistilled(delta_only, copy));
+  EXPECT_EQ(copy.walls.size(), 8u);  // upserted, not duplicated
+  EXPECT_EQ(copy.rooms.size(), 2u);
+  // Too small a buffer is a clear error.
+  EXPECT_EQ(EncodeDistilled(g, 0, std::span(buffer.data(), 100)).error().code,
+            Errc::kCapacityExceeded);
+}
+
+// Re-seals a tampered message so that the CRC passes and the parser itself must object.
+void Reseal(std::vector<std::uint8_t>& m) {
+  WriteU32Le(&m[m.size() - 4], Crc32(std::span(m.data(), m.size() - 4)));
+}
+
+TEST(DistilledCodec, RejectsMalformedInputWithAReason) {
+  const DistilledGraph g = SampleGraph();
+  std::vector<std::uint8_t> good(4096);
+  good.resize(*EncodeDistilled(g, 0, good));
+  DistilledGraph out;
+  out.Init(16, 4);
+  auto expect = [&](std::vector<std::uint8_t> m, Errc code) {
+    auto r = DecodeDistilled(m, out);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, code) << r.error().detail;
+  };
+  expect({}, Errc::kMalformed);
+  expect(std::vector<std::uint8_t>(good.begin(), good.begin() + 30), Errc::kChecksum);  // truncated
+  auto flipped = good;
+  flipped[40] ^= 0x10;
+  expect(flipped, Errc::kChecksum);
+  auto magic = good;
+  magic[0] = 'X';
+  Reseal(magic);
+  expect(magic, Errc::kMalformed);
+  auto format = good;
+  format[4] = 9;
+  Reseal(format);
+  expect(format, Errc::kUnsupported);
+  auto count = good;
+  count[16] = 9;  // nine walls claimed
+  Reseal(count);
+  expect(count, Errc::kMalformed);
+  auto normal = good;
+  const float two = 2.0f;
+  std::uint32_t bits;
+  std::memcpy(&bits, &two, 4);
+  WriteU32Le(&normal[20 + 8 + 8], bits);  // first wall's normal x
+  Reseal(normal);
+  expect(normal, Errc::kMalformed);
+  auto nan = good;
+  const float q = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(&bits, &q, 4);
+  WriteU32Le(&nan[20 + 8 + 8 + 12], bits);  // first wall's d
+  Reseal(nan);
+  expect(nan, Errc::kMalformed);
+  auto covariance = good;
+  const float negative = -1.0f;
+  std::memcpy(&bits, &negative, 4);
+  WriteU32Le(&covariance[20 + 8 + 8 + 16], bits);  // first wall's covariance xx
+  Reseal(covariance);
+  expect(covariance, Errc::kMalformed);
+  auto unknown_wall = good;
+  const std::size_t room0 = 20 + 8 + 8 * kDistilledWallBytes;
+  WriteU32Le(&unknown_wall[room0 + 29], 999);  // the first room's first wall id
+  Reseal(unknown_wall);
+  expect(unknown_wall, Errc::kMalformed);
+  auto shape = good;
+  shape[room0 + 8] = 7;
+  Reseal(shape);
+  expect(shape, Errc::kMalformed);
+  // More elements than the receiver holds.
+  DistilledGraph small;
+  small.Init(2, 1);
+  auto r = DecodeDistilled(good, small);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, Errc::kCapacityExceeded);
+  // And the intact message still decodes.
+  EXPECT_TRUE(DecodeDistilled(good, out));
+}
+
+TEST(RoomMessages, DescriptorsAndCloudsRoundTripCompactly) {
+  const auto cloud = test::BoxRoom(6, 4, 2.4, 3000, 0.01, 3,
+                                   Eigen::Isometry3d(Eigen::Translation3d(-3, -2, 0)), false);
+  ScanContext sc;
+  ASSERT_TRUE(sc.Build(cloud, {20, 60, 12.0f, 0.0f}));
+  std::vector<std::uint8_t> buffer(1 << 20);
+  auto n = EncodeRoomDescriptor({2, 7, 4}, sc, buffer);
+  ASSERT_TRUE(n);
+  EXPECT_EQ(*n, 21u + 20u * 60u + 4u);
+  ScanContext back;
+  auto h = DecodeRoomDescriptor(std::span(buffer.data(), *n), back);
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->room, 7u);
+  for (int r = 0; r < 20; ++r) {
+    for (int s = 0; s < 60; ++s) EXPECT_NEAR(back.cell(r, s), sc.cell(r, s), 0.0051f);
+  }
+  EXPECT_LT(ScanContextDistance(sc, back)->distance, 0.01f);
+  // Clouds: float and 1 cm quantised (half the bytes, within 5 mm).
+  BoundedVector<Eigen::Vector3f> points(4000);
+  for (CloudEncoding e : {CloudEncoding::kFloat32, CloudEncoding::kQuantised16}) {
+    auto c = EncodeRoomCloud({2, 7, 4, e, 0.01f}, cloud, buffer);
+    ASSERT_TRUE(c);
+    EXPECT_EQ(*c, RoomCloudEncodedSize(e, cloud.size()));
+    ASSERT_TRUE(DecodeRoomCloud(std::span(buffer.data(), *c), points));
+    ASSERT_EQ(points.size(), cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      EXPECT_LT((points[i] - cloud[i]).norm(), e == CloudEncoding::kFloat32 ? 1e-7f : 0.0087f);
+    }
+  }
+  EXPECT_EQ(RoomCloudEncodedSize(CloudEncoding::kQuantised16, 1000) - 28, 6000u);
+  // Bad input: CRC, capacity, length, a point beyond the quantised range.
+  auto c = *EncodeRoomCloud({2, 7, 4, CloudEncoding::kQuantised16, 0.01f}, cloud, buffer);
+  std::vector<std::uint8_t> m(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(c));
+  m[30] ^= 1;
+  EXPECT_EQ(DecodeRoomCloud(m, points).error().code, Errc::kChecksum);
+  BoundedVector<Eigen::Vector3f> few(10);
+  EXPECT_EQ(DecodeRoomCloud(std::span(buffer.data(), c), few).error().code,
+            Errc::kCapacityExceeded);
+  m.assign(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(c));
+  m.insert(m.end() - 4, {0, 0});
+  Reseal(m);
+  EXPECT_EQ(DecodeRoomCloud(m, points).error().code, Errc::kMalformed);
+  const std::vector<Eigen::Vector3f> far{Eigen::Vector3f(400, 0, 0)};
+  EXPECT_EQ(
+      EncodeRoomCloud({2, 7, 4, CloudEncoding::kQuantised16, 0.01f}, far, buffer).error().code,
+      Errc::kInvalidArgument);
+  std::vector<std::uint8_t> d(
+      buffer.begin(),
+      buffer.begin() + static_cast<std::ptrdiff_t>(*EncodeRoomDescriptor({2, 7, 4}, sc, buffer)));
+  d[15] = 90;  // rings beyond the maximum
+  Reseal(d);
+  EXPECT_EQ(DecodeRoomDescriptor(d, back).error().code, Errc::kMalformed);
+}
+
+TEST(RoomMatcher, ConsistencyCheckRejectsAPlantedSymmetricMismatch) {
+  // Three true matches agree on the map-to-map transform; two identical rooms elsewhere in a
+  // symmetric building align just as well, but to transforms shifted by the building's period.
+  const Eigen::Isometry3d truth = Planar(4.0, -2.0, 0.7);
+  std::vector<RoomMatch> matches;
+  for (int i = 0; i < 3; ++i) {
+    RoomMatch m;
+    m.room_a = static_cast<std::uint32_t>(i);
+    m.T_a_b = truth * Planar(0.02 * i, -0.01 * i, 0.002 * i);
+    matches.push_back(m);
+  }
+  for (int i = 0; i < 2; ++i) {
+    RoomMatch m;
+    m.room_a = 10u + static_cast<std::uint32_t>(i);
+    m.T_a_b = Planar(6.0 * (i + 1), 0, 0) * truth;  // the room next door, and the one after
+    matches.insert(matches.begin() + 1, m);
+  }
+  RoomMatchConfig config;
+  std::uint32_t keep[8];
+  const std::size_t n = ConsistentMatches(matches, config, keep);
+  ASSERT_EQ(n, 3u);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_LT(matches[keep[i]].room_a, 10u);
+  // One match alone cannot be checked: nothing is kept.
+  EXPECT_EQ(ConsistentMatches(std::span(matches).first(1), config, keep), 0u);
+  // Two symmetric mismatches alone disagree with each other: nothing is kept.
+  EXPECT_EQ(ConsistentMatches(std::span(matches).subspan(1, 2), config, keep), 0u);
+}
+
+TEST(RoomMatcher, FineAlignmentRecoversTheMapToMapTransform) {
+  // The same room (furnished, so not symmetric) seen by two robots whose maps differ by truth.
+  auto room = test::BoxRoom(6, 4, 2.4, 6000, 0.01, 5,
+                            Eigen::Isometry3d(Eigen::Translation3d(-3, -2, 0)), false);
+  const auto box = test::BoxRoom(1.0, 0.6, 0.8, 1500, 0.01, 6,
+                                 Eigen::Isometry3d(Eigen::Translation3d(1.2, 0.6, 0)), false);
+  room.insert(room.end(), box.begin(), box.end());
+  const Eigen::Isometry3d truth = Planar(5.0, 1.0, 2.0);  // map a from map b
+  const Eigen::Isometry3d T_ma_ra = Planar(2.0, 3.0, 0.1);
+  // Robot b's room frame is the room rotated by a quarter turn (frames are defined up to them)
+  // and off by a few centimetres, as its own estimate would be.
+  const Eigen::Isometry3d T_ra_rb = Planar(0.04, -0.03, std::numbers::pi / 2 + 0.01);
+  const Eigen::Isometry3d T_mb_rb = truth.inverse() * T_ma_ra * T_ra_rb;
+  std::vector<Eigen::Vector3f> cloud_b;
+  for (const auto& p : room)
+    cloud_b.push_back((T_ra_rb.inverse() * p.cast<double>()).cast<float>());
+  RoomMatcher matcher;
+  ASSERT_TRUE(matcher.Init({}));
+  RoomMatch m;
+  ASSERT_TRUE(matcher.FineAlign(room, T_ma_ra, cloud_b, T_mb_rb, std::numbers::pi / 2, m));
+  const Eigen::Isometry3d e = truth.inverse() * m.T_a_b;
+  EXPECT_LT(e.translation().norm(), 0.02);
+  EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 0.005);
+  EXPECT_LT(m.fitness_m2, 0.01);
+  // A wrong seed a quarter turn off is found by trying the others.
+  RoomMatch m2;
+  ASSERT_TRUE(matcher.FineAlign(room, T_ma_ra, cloud_b, T_mb_rb, 0.0, m2));
+  EXPECT_LT((truth.inverse() * m2.T_a_b).translation().norm(), 0.02);
+}
+
+TEST(CollaborativeGraph, RecoversAnotherRobotsOriginFromRoomsAndWalls) {
+  const Eigen::Isometry3d truth = Planar(7.0, -3.0, 1.1);  // robot 2's map in robot 1's
+  DistilledGraph a, b;
+  a.Init(16, 4);
+  b.Init(16, 4);
+  AddRoom(a, 0, 0, Planar(2, 3, 0.3), 1);
+  AddRoom(a, 4, 1, Planar(10, 2, 0.3), 1);
+  AddRoom(b, 0, 0, truth.inverse() * Planar(2, 3, 0.3), 1);
+  AddRoom(b, 4, 1, truth.inverse() * Planar(10, 2, 0.3), 1);
+  for (bool walls : {false, true}) {
+    CollaborativeGraph g;
+    ASSERT_TRUE(g.Init({}));
+    ASSERT_TRUE(g.SetInitial(2, truth * Planar(0.3, -0.2, 0.05)));  // what a room match suggests
+    for (std::size_t r = 0; r < 2; ++r) {
+      ASSERT_TRUE(g.AddRoomRoom(2, a.rooms[r].centre, a.rooms[r].yaw_rad, b.rooms[r].centre,
+                                b.rooms[r].yaw_rad));
+      if (!walls) continue;
+      for (std::size_t w = 0; w < 4; ++w)
+        ASSERT_TRUE(g.AddWallWall(2, a.walls[r * 4 + w], b.walls[r * 4 + w]));
+    }
+    ASSERT_TRUE(g.Solve());
+    const Eigen::Isometry3d e = truth.inverse() * g.T_self_robot(2);
+    EXPECT_LT(e.translation().norm(), 1e-3) << (walls ? "rooms and walls" : "rooms");
+    EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 1e-4);
+  }
+  CollaborativeGraph g;
+  ASSERT_TRUE(g.Init({}));
+  EXPECT_FALSE(g.AddRoomRoom(3, {0, 0}, 0, {0, 0}, 0));  // no initial origin for robot 3
+  EXPECT_FALSE(g.SetInitial(99, truth));                 // beyond max_robots
+}
+
+TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
+  SGraph graph;
+  ASSERT_TRUE(graph.Init({}));
+  PlaneMapper planes;
+  ASSERT_TRUE(planes.Init(64, {}));
+  // Two keyframes in a 6 x 4 m room see its four walls.
+  const Eigen::Isometry3d T_room = Planar(2, 3, 0.3);
+  DistilledGraph truth;
+  truth.Init(8, 2);
+  AddRoom(truth, 0, 0, T_room, 1);
+  std::vector<std::uint32_t> ids;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Isometry3d T = T_room * Planar(0.5 * k - 0.5, 0.2, 0.1 * k);
+    const std::uint32_t kf = *graph.AddKeyframe(k, T);
+    if (k > 0) {
+      ASSERT_TRUE(graph.AddRelativePose(kf - 1, kf, graph.keyframe_pose(kf - 1).inverse() * T,
+                                        Matrix6d::Identity() * 1e4, RelativePoseKind::kOdometry));
+    }
+    for (std::size_t w = 0; w < 4; ++w) {
+      const DistilledWall& tw = truth.walls[w];
+      if (k == 0) ids.push_back(*graph.AddPlane(tw.normal, tw.d, PlaneClass::kWall));
+      PlaneMeasurement z;
+      z.normal = T.linear().transpose() * tw.normal;
+      z.d = tw.d + tw.normal.dot(T.translation());
+      WallBasis(z.normal, z.basis_u, z.basis_v);
+      z.covariance = Eigen::Matrix3d::Identity() * 1e-4;
+      ASSERT_TRUE(graph.AddPlaneObservation(kf, ids[w], z));
+    }
+  }
+  MapRoom room;
+  room.centre = T_room.translation().head<2>();
+  for (std::size_t w = 0; w < 4; ++w) room.walls[w] = static_cast<std::int32_t>(ids[w]);
+  ASSERT_TRUE(graph.AddRoom(room));
+  Distiller distiller;
+  ASSERT_TRUE(distiller.Init(1, 64, {}));
+  ASSERT_TRUE(distiller.Update(graph, planes));
+  const DistilledGraph& g = distiller.graph();
+  EXPECT_EQ(g.version, 1u);
+  ASSERT_EQ(g.walls.size(), 4u);
+  ASSERT_EQ(g.rooms.size(), 1u);
+  for (const DistilledWall& w : g.walls) {
+    EXPECT_EQ(Eigen::LLT<Eigen::Matrix3d>(w.covariance).info(), Eigen::Success);
+    // Three observations at 1 cm, 3-4 m from the map origin: the offset there is known to a few cm.
+    EXPECT_LT(w.covariance(2, 2), 1e-3);
+  }
+  EXPECT_NEAR(g.rooms[0].size_x_m, 6.0, 1e-6);
+  EXPECT_NEAR(g.rooms[0].size_y_m, 4.0, 1e-6);
+  EXPECT_NEAR(std::remainder(g.rooms[0].yaw_rad - 0.3, std::numbers::pi / 2), 0.0, 1e-6);
+  // Nothing changed: no new version, nothing to send.
+  EXPECT_FALSE(distiller.Update(graph, planes));
+  std::vector<std::uint8_t> buffer(4096);
+  EXPECT_EQ(*EncodeDistilled(g, g.version, buffer),
+            kDistilledHeaderBytes + 4);  // no floor in this graph
+}
+
+}  // namespace
+}  // namespace msgraphs::core
