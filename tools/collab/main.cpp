@@ -14,7 +14,9 @@
 // message type.
 //
 //   msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine]
-//                   [--cloud f32|q16] [--exchange-every-s 10] [--markdown]
+//                   [--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]
+//
+// --out DIR writes robotN_in_robot1.tum: every merged robot's keyframes in robot 1's frame.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -50,7 +52,8 @@ bool Fine(Mode m) { return m == Mode::kRoomsFine || m == Mode::kRoomsWallsFine; 
 bool Walls(Mode m) { return m == Mode::kRoomsWalls || m == Mode::kRoomsWallsFine; }
 
 enum MessageType { kGraph, kDescriptor, kCloudRequest, kCloud, kMessageTypes };
-const char* kTypeNames[kMessageTypes] = {"distilled graph", "room descriptors", "room cloud requests", "room clouds"};
+const char* kTypeNames[kMessageTypes] = {"distilled graph", "room descriptors",
+                                         "room cloud requests", "room clouds"};
 constexpr std::size_t kCloudRequestBytes = 16;  // robot, room, version, CRC
 
 struct RoomDescriptorEntry {
@@ -68,15 +71,18 @@ constexpr double kDescriptorResendM = 0.3;
 constexpr std::size_t kAnchoredMatches = 3;
 
 bool SignificantlyChanged(const core::DistilledRoom& a, const core::DistilledRoom& b) {
-  return a.walls != b.walls || a.shape != b.shape || (a.centre - b.centre).norm() > kDescriptorResendM ||
-         std::fabs(a.size_x_m - b.size_x_m) > kDescriptorResendM || std::fabs(a.size_y_m - b.size_y_m) > kDescriptorResendM;
+  return a.walls != b.walls || a.shape != b.shape ||
+         (a.centre - b.centre).norm() > kDescriptorResendM ||
+         std::fabs(a.size_x_m - b.size_x_m) > kDescriptorResendM ||
+         std::fabs(a.size_y_m - b.size_y_m) > kDescriptorResendM;
 }
 
 struct Robot {
   int index = 0;  // 0-based; robot ids on the wire are index + 1
   std::unique_ptr<tools::RecordedScans> scans;
   std::optional<drivers::can_odometry::CandumpFileReader> candump;
-  drivers::can_odometry::OdometryStream odometry = drivers::can_odometry::OdometryStream::Create({}).value();
+  drivers::can_odometry::OdometryStream odometry =
+      drivers::can_odometry::OdometryStream::Create({}).value();
   bool odometry_done = false, scans_done = false;
   const drivers::velodyne::Scan* pending = nullptr;
   double first_stamp = -1;
@@ -91,7 +97,8 @@ struct Robot {
   std::map<int, core::DistilledGraph> peer_graphs;
   std::map<std::pair<int, std::uint32_t>, RoomDescriptorEntry> peer_descriptors;
   std::set<std::tuple<int, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> tried;
-  std::map<std::tuple<int, std::uint32_t, std::uint32_t>, std::vector<Eigen::Vector3f>> peer_clouds;  // cache
+  std::map<std::tuple<int, std::uint32_t, std::uint32_t>, std::vector<Eigen::Vector3f>>
+      peer_clouds;                                      // cache
   std::map<int, std::vector<core::RoomMatch>> matches;  // per peer: accepted by the fine check
   std::uint64_t rejected_anchored = 0, accepted_anchored = 0;
   std::map<int, std::vector<std::uint32_t>> consistent;  // per peer: indices into matches
@@ -100,12 +107,16 @@ struct Robot {
   std::vector<tools::StampedPose> truth;
 };
 
-double Now(const Robot& r) { return r.pending == nullptr ? 1e300 : r.pending->end_time.seconds_since_epoch() - r.first_stamp; }
+double Now(const Robot& r) {
+  return r.pending == nullptr ? 1e300 : r.pending->end_time.seconds_since_epoch() - r.first_stamp;
+}
 
 void Advance(Robot& r) {
   r.pending = r.scans->Next();
-  if (r.pending == nullptr) r.scans_done = true;
-  else if (r.first_stamp < 0) r.first_stamp = r.pending->end_time.seconds_since_epoch();
+  if (r.pending == nullptr)
+    r.scans_done = true;
+  else if (r.first_stamp < 0)
+    r.first_stamp = r.pending->end_time.seconds_since_epoch();
 }
 
 void FeedOdometry(Robot& r, double until) {
@@ -119,9 +130,10 @@ void FeedOdometry(Robot& r, double until) {
     if (!r.odometry.Add(line.frame, line.stamp)) continue;
     const auto& p = r.odometry.pose();
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(p.T_odom_base.qw, p.T_odom_base.qx, p.T_odom_base.qy, p.T_odom_base.qz)
-                     .normalized()
-                     .toRotationMatrix();
+    T.linear() =
+        Eigen::Quaterniond(p.T_odom_base.qw, p.T_odom_base.qx, p.T_odom_base.qy, p.T_odom_base.qz)
+            .normalized()
+            .toRotationMatrix();
     T.translation() << p.T_odom_base.x_m, p.T_odom_base.y_m, p.T_odom_base.z_m;
     static_cast<void>(r.mapper.AddOdometry(p.stamp.seconds_since_epoch(), T));
   }
@@ -198,10 +210,12 @@ struct Mission {
       entry.version = room.version;
       entry.room = room;
       entry.room_at_build = room;
-      if (!from.descriptor_builder.Build(from.mapper, room, cloud_scratch, entry.descriptor)) continue;
+      if (!from.descriptor_builder.Build(from.mapper, room, cloud_scratch, entry.descriptor))
+        continue;
       from.room_clouds[room.id].assign(cloud_scratch.begin(), cloud_scratch.end());
       from.own_descriptors[room.id] = entry;
-      const core::RoomDescriptorHeader header{static_cast<std::uint16_t>(from.index + 1), room.id, room.version};
+      const core::RoomDescriptorHeader header{static_cast<std::uint16_t>(from.index + 1), room.id,
+                                              room.version};
       auto n = core::EncodeRoomDescriptor(header, entry.descriptor, buffer);
       if (!n) continue;
       for (auto& to : robots) {
@@ -237,7 +251,8 @@ struct Mission {
       const int b_index = key.first;
       Robot& b = *robots[static_cast<std::size_t>(b_index)];
       for (const auto& [room_a_id, mine] : a.own_descriptors) {
-        const auto tried_key = std::make_tuple(b_index, room_a_id, mine.version, key.second, theirs.version);
+        const auto tried_key =
+            std::make_tuple(b_index, room_a_id, mine.version, key.second, theirs.version);
         if (a.tried.count(tried_key) != 0) continue;
         a.tried.insert(tried_key);
         const auto sc = core::ScanContextDistance(mine.descriptor, theirs.descriptor, true);
@@ -249,7 +264,8 @@ struct Mission {
         m.room_a = room_a_id;
         m.room_b = key.second;
         m.sc_distance = sc->distance;
-        const double floor_a = -a.mapper.config().base_height_m, floor_b = -b.mapper.config().base_height_m;
+        const double floor_a = -a.mapper.config().base_height_m,
+                     floor_b = -b.mapper.config().base_height_m;
         const Eigen::Isometry3d T_ma_ra = core::RoomFrame(mine.room, floor_a);
         const Eigen::Isometry3d T_mb_rb = core::RoomFrame(theirs.room, floor_b);
         const auto robot_b = static_cast<std::uint16_t>(b.index + 1);
@@ -261,10 +277,11 @@ struct Mission {
           const Eigen::Isometry3d estimate = a.collab.T_self_robot(robot_b);
           bool agrees = false;
           for (int q = 0; q < 4 && !agrees; ++q) {
-            const Eigen::Isometry3d T =
-                core::MatchFromRoomFrames(T_ma_ra, T_mb_rb, static_cast<double>(sc->yaw_rad) + q * 1.5707963267948966);
+            const Eigen::Isometry3d T = core::MatchFromRoomFrames(
+                T_ma_ra, T_mb_rb, static_cast<double>(sc->yaw_rad) + q * 1.5707963267948966);
             const Eigen::Isometry3d e = estimate.inverse() * T;
-            if (e.translation().head<2>().norm() < 0.5 && Eigen::AngleAxisd(e.linear()).angle() < 0.1) {
+            if (e.translation().head<2>().norm() < 0.5 &&
+                Eigen::AngleAxisd(e.linear()).angle() < 0.1) {
               m.T_a_b = T;
               agrees = true;
             }
@@ -281,7 +298,8 @@ struct Mission {
           if (cached == a.peer_clouds.end()) {
             accounting.Add(kCloudRequest, a.index, b.index, kCloudRequestBytes);
             const auto& cloud_b = b.room_clouds[key.second];
-            core::RoomCloudHeader header{robot_b, key.second, theirs.version, cloud_encoding, 0.01f};
+            core::RoomCloudHeader header{robot_b, key.second, theirs.version, cloud_encoding,
+                                         0.01f};
             auto n = core::EncodeRoomCloud(header, cloud_b, buffer);
             if (!n) continue;
             accounting.Add(kCloud, b.index, a.index, *n);
@@ -289,10 +307,14 @@ struct Mission {
               ++accounting.malformed;
               continue;
             }
-            cached = a.peer_clouds.emplace(cache_key, std::vector<Eigen::Vector3f>(decoded_cloud.begin(), decoded_cloud.end())).first;
+            cached = a.peer_clouds
+                         .emplace(cache_key, std::vector<Eigen::Vector3f>(decoded_cloud.begin(),
+                                                                          decoded_cloud.end()))
+                         .first;
           }
           const auto& cloud_a = a.room_clouds[room_a_id];
-          if (!matcher.FineAlign(cloud_a, T_ma_ra, cached->second, T_mb_rb, static_cast<double>(sc->yaw_rad), m)) {
+          if (!matcher.FineAlign(cloud_a, T_ma_ra, cached->second, T_mb_rb,
+                                 static_cast<double>(sc->yaw_rad), m)) {
             ++a.rejected_fine;
             continue;
           }
@@ -326,14 +348,20 @@ struct Mission {
         for (const auto& r : mine.rooms) ra = r.id == m.room_a ? &r : ra;
         for (const auto& r : theirs.rooms) rb = r.id == m.room_b ? &r : rb;
         if (ra == nullptr || rb == nullptr) continue;
-        static_cast<void>(a.collab.AddRoomRoom(robot_b, ra->centre, ra->yaw_rad, rb->centre, rb->yaw_rad));
+        static_cast<void>(
+            a.collab.AddRoomRoom(robot_b, ra->centre, ra->yaw_rad, rb->centre, rb->yaw_rad));
+        // A fine alignment measured the origin directly, from the room clouds themselves.
+        if (m.fine_aligned)
+          static_cast<void>(a.collab.AddOriginMeasurement(robot_b, m.T_a_b, 0.03, 0.005));
         if (!Walls(mode)) continue;
         // Pair the two rooms' walls through the match: same facing and offset after T_a_b.
         for (std::int32_t wa : ra->walls) {
-          const core::DistilledWall* A = wa < 0 ? nullptr : mine.FindWall(static_cast<std::uint32_t>(wa));
+          const core::DistilledWall* A =
+              wa < 0 ? nullptr : mine.FindWall(static_cast<std::uint32_t>(wa));
           if (A == nullptr) continue;
           for (std::int32_t wb : rb->walls) {
-            const core::DistilledWall* B = wb < 0 ? nullptr : theirs.FindWall(static_cast<std::uint32_t>(wb));
+            const core::DistilledWall* B =
+                wb < 0 ? nullptr : theirs.FindWall(static_cast<std::uint32_t>(wb));
             if (B == nullptr) continue;
             const Eigen::Vector3d n = m.T_a_b.linear() * B->normal;
             const double d = B->d - n.dot(m.T_a_b.translation());
@@ -351,31 +379,43 @@ struct Mission {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string run;
+  std::string run, out_dir;
   Mission mission;
   double every_s = 10.0;
   bool markdown = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--run" && i + 1 < argc) run = argv[++i];
-    else if (a == "--exchange-every-s" && i + 1 < argc) every_s = std::atof(argv[++i]);
-    else if (a == "--markdown") markdown = true;
+    if (a == "--run" && i + 1 < argc)
+      run = argv[++i];
+    else if (a == "--exchange-every-s" && i + 1 < argc)
+      every_s = std::atof(argv[++i]);
+    else if (a == "--markdown")
+      markdown = true;
+    else if (a == "--out" && i + 1 < argc)
+      out_dir = argv[++i];
     else if (a == "--mode" && i + 1 < argc) {
       const std::string m = argv[++i];
-      if (m == "rooms") mission.mode = Mode::kRooms;
-      else if (m == "rooms-fine") mission.mode = Mode::kRoomsFine;
-      else if (m == "rooms-walls") mission.mode = Mode::kRoomsWalls;
-      else if (m == "rooms-walls-fine") mission.mode = Mode::kRoomsWallsFine;
+      if (m == "rooms")
+        mission.mode = Mode::kRooms;
+      else if (m == "rooms-fine")
+        mission.mode = Mode::kRoomsFine;
+      else if (m == "rooms-walls")
+        mission.mode = Mode::kRoomsWalls;
+      else if (m == "rooms-walls-fine")
+        mission.mode = Mode::kRoomsWallsFine;
       else {
         std::fprintf(stderr, "collab: unknown mode %s\n", m.c_str());
         return 2;
       }
     } else if (a == "--cloud" && i + 1 < argc) {
       const std::string c = argv[++i];
-      mission.cloud_encoding = c == "f32" ? core::CloudEncoding::kFloat32 : core::CloudEncoding::kQuantised16;
+      mission.cloud_encoding =
+          c == "f32" ? core::CloudEncoding::kFloat32 : core::CloudEncoding::kQuantised16;
     } else {
-      std::fprintf(stderr, "usage: msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine] "
-                           "[--cloud f32|q16] [--exchange-every-s 10] [--markdown]\n");
+      std::fprintf(
+          stderr,
+          "usage: msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine] "
+          "[--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]\n");
       return 2;
     }
   }
@@ -397,7 +437,8 @@ int main(int argc, char** argv) {
     }
     r->candump.emplace(std::move(*candump));
     core::LocalMapperConfig config;
-    if (!r->mapper.Init(config) || !r->distiller.Init(static_cast<std::uint16_t>(i + 1), config.graph.max_planes, {}) ||
+    if (!r->mapper.Init(config) ||
+        !r->distiller.Init(static_cast<std::uint16_t>(i + 1), config.graph.max_planes, {}) ||
         !r->descriptor_builder.Init({}) || !r->collab.Init({})) {
       return 1;
     }
@@ -428,7 +469,8 @@ int main(int argc, char** argv) {
   for (auto& r : mission.robots) static_cast<void>(r->mapper.Finish());
   for (auto& r : mission.robots) mission.Exchange(*r);
   for (auto& r : mission.robots) mission.Match(*r);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // ---- evaluation from robot 1 ----
   Robot& self = *mission.robots[0];
@@ -445,11 +487,22 @@ int main(int argc, char** argv) {
     std::sort(kf.begin(), kf.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
     const auto own = tools::ComputeAte(kf, r->truth, 0.006);
     T_world_map[static_cast<std::size_t>(r->index)] = own.T_truth_estimate;
-    const bool in = r->index == 0 || self.collab.has_robot(static_cast<std::uint16_t>(r->index + 1));
+    const bool in =
+        r->index == 0 || self.collab.has_robot(static_cast<std::uint16_t>(r->index + 1));
     if (r->index != 0 && in) ++merged;
     if (!in) continue;
-    const Eigen::Isometry3d T_1_b = r->index == 0 ? Eigen::Isometry3d::Identity()
-                                                  : self.collab.T_self_robot(static_cast<std::uint16_t>(r->index + 1));
+    const Eigen::Isometry3d T_1_b =
+        r->index == 0 ? Eigen::Isometry3d::Identity()
+                      : self.collab.T_self_robot(static_cast<std::uint16_t>(r->index + 1));
+    if (!out_dir.empty()) {
+      std::vector<tools::StampedPose> in_1;
+      for (const auto& p : kf) in_1.push_back({p.t, T_1_b * p.T});
+      fs::create_directories(out_dir);
+      static_cast<void>(tools::WriteTum(
+          (fs::path(out_dir) / ("robot" + std::to_string(r->index + 1) + "_in_robot1.tum"))
+              .string(),
+          in_1));
+    }
     for (const auto& p : kf) {
       // Stamps differ per robot clock: pair each keyframe with its own robot's truth here.
       if (const tools::StampedPose* t = tools::Nearest(r->truth, p.t, 0.006)) {
@@ -468,11 +521,13 @@ int main(int argc, char** argv) {
                                         T_world_map[static_cast<std::size_t>(b_index)];
         const Eigen::Isometry3d e = truth.inverse() * m.T_a_b;
         ++accepted;
-        if (e.translation().head<2>().norm() > 0.5 || Eigen::AngleAxisd(e.linear()).angle() > 0.1) ++wrong;
+        if (e.translation().head<2>().norm() > 0.5 || Eigen::AngleAxisd(e.linear()).angle() > 0.1)
+          ++wrong;
       }
     }
   }
-  std::uint64_t proposed = 0, rejected_fine = 0, rejected_consistency = 0, rejected_anchored = 0, accepted_anchored = 0;
+  std::uint64_t proposed = 0, rejected_fine = 0, rejected_consistency = 0, rejected_anchored = 0,
+                accepted_anchored = 0;
   for (auto& r : mission.robots) {
     for (const auto& [b, list] : r->matches) proposed += list.size();
     rejected_fine += r->rejected_fine;
@@ -481,19 +536,22 @@ int main(int argc, char** argv) {
     accepted_anchored += r->accepted_anchored;
   }
   const auto ate = tools::ComputeAte(aggregated, aggregated_truth, 0.5);
-  const char* mode_names[] = {"Rooms", "Rooms + fine alignment", "Rooms and walls", "Rooms and walls + fine alignment"};
+  const char* mode_names[] = {"Rooms", "Rooms + fine alignment", "Rooms and walls",
+                              "Rooms and walls + fine alignment"};
   const double mb = static_cast<double>(mission.accounting.Total()) / 1e6;
   if (markdown) {
-    std::printf("| %s | %zu | %s | %zu / %zu | %.3f | %.3f | %llu / %llu | %llu |\n", run.c_str(), mission.robots.size(),
-                mode_names[static_cast<int>(mission.mode)], merged, mission.robots.size(), ate.rmse, mb,
-                static_cast<unsigned long long>(accepted - wrong), static_cast<unsigned long long>(accepted),
-                static_cast<unsigned long long>(wrong));
+    std::printf("| %s | %zu | %s | %zu / %zu | %.3f | %.3f | %llu / %llu | %llu |\n", run.c_str(),
+                mission.robots.size(), mode_names[static_cast<int>(mission.mode)], merged,
+                mission.robots.size(), ate.rmse, mb,
+                static_cast<unsigned long long>(accepted - wrong),
+                static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(wrong));
     return 0;
   }
   std::printf("mission %s: %zu robots, mode %s, %.1f s\n", run.c_str(), mission.robots.size(),
               mode_names[static_cast<int>(mission.mode)], seconds);
-  std::printf("robot 1 merged %zu of %zu robots; aggregated ATE %.3f m over %zu keyframes (max %.3f m)\n", merged,
-              mission.robots.size(), ate.rmse, ate.poses, ate.max);
+  std::printf(
+      "robot 1 merged %zu of %zu robots; aggregated ATE %.3f m over %zu keyframes (max %.3f m)\n",
+      merged, mission.robots.size(), ate.rmse, ate.poses, ate.max);
   for (auto& r : mission.robots) {
     if (r->index == 0) continue;
     const auto robot = static_cast<std::uint16_t>(r->index + 1);
@@ -501,24 +559,42 @@ int main(int argc, char** argv) {
       std::printf("  robot %d: not merged\n", r->index + 1);
       continue;
     }
-    const Eigen::Isometry3d truth = T_world_map[0].inverse() * T_world_map[static_cast<std::size_t>(r->index)];
+    const Eigen::Isometry3d truth =
+        T_world_map[0].inverse() * T_world_map[static_cast<std::size_t>(r->index)];
     const Eigen::Isometry3d e = truth.inverse() * self.collab.T_self_robot(robot);
-    std::printf("  robot %d: origin error %.3f m, %.2f deg (%zu factors)\n", r->index + 1, e.translation().head<2>().norm(),
-                Eigen::AngleAxisd(e.linear()).angle() * 180.0 / 3.14159265358979, self.collab.factors(robot));
+    std::printf("  robot %d: origin error %.3f m, %.2f deg (%zu factors)\n", r->index + 1,
+                e.translation().head<2>().norm(),
+                Eigen::AngleAxisd(e.linear()).angle() * 180.0 / 3.14159265358979,
+                self.collab.factors(robot));
   }
-  std::printf("room matches (all robots): %llu proposed by Scan Context, %llu rejected by fine alignment, %llu checked "
-              "against a merged estimate (%llu rejected), %llu rejected by the consistency check, %llu accepted, %llu of them "
-              "wrong against the truth\n",
-              static_cast<unsigned long long>(proposed + rejected_fine + rejected_anchored),
-              static_cast<unsigned long long>(rejected_fine),
-              static_cast<unsigned long long>(accepted_anchored + rejected_anchored),
-              static_cast<unsigned long long>(rejected_anchored),
-              static_cast<unsigned long long>(rejected_consistency), static_cast<unsigned long long>(accepted),
-              static_cast<unsigned long long>(wrong));
+  std::printf(
+      "room matches (all robots): %llu proposed by Scan Context, %llu rejected by fine alignment, "
+      "%llu checked "
+      "against a merged estimate (%llu rejected), %llu rejected by the consistency check, %llu "
+      "accepted, %llu of them "
+      "wrong against the truth\n",
+      static_cast<unsigned long long>(proposed + rejected_fine + rejected_anchored),
+      static_cast<unsigned long long>(rejected_fine),
+      static_cast<unsigned long long>(accepted_anchored + rejected_anchored),
+      static_cast<unsigned long long>(rejected_anchored),
+      static_cast<unsigned long long>(rejected_consistency),
+      static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(wrong));
   std::printf("data exchanged: %.3f MB in total, %llu messages malformed\n", mb,
               static_cast<unsigned long long>(mission.accounting.malformed));
   for (int t = 0; t < kMessageTypes; ++t) {
-    std::printf("  %-20s %10.1f kB\n", kTypeNames[t], static_cast<double>(mission.accounting.Total(t)) / 1e3);
+    std::printf("  %-20s %10.1f kB\n", kTypeNames[t],
+                static_cast<double>(mission.accounting.Total(t)) / 1e3);
+  }
+  for (const auto& from : mission.robots) {
+    for (const auto& to : mission.robots) {
+      if (from == to) continue;
+      std::uint64_t sum = 0;
+      for (const auto& [key, n] : mission.accounting.bytes) {
+        if (std::get<1>(key) == from->index && std::get<2>(key) == to->index) sum += n;
+      }
+      std::printf("  robot %d -> robot %d %10.1f kB\n", from->index + 1, to->index + 1,
+                  static_cast<double>(sum) / 1e3);
+    }
   }
   return 0;
 }

@@ -47,6 +47,17 @@ struct WallWallResidual {
   }
 };
 
+struct OriginResidual {
+  double x, y, yaw, inv_sigma, inv_sigma_yaw;
+  template <typename T>
+  bool operator()(const T* origin, T* r) const {
+    r[0] = (origin[0] - T(x)) * T(inv_sigma);
+    r[1] = (origin[1] - T(y)) * T(inv_sigma);
+    r[2] = sin(origin[2] - T(yaw)) * T(inv_sigma_yaw);
+    return true;
+  }
+};
+
 }  // namespace
 
 Status CollaborativeGraphConfig::Validate() const {
@@ -158,6 +169,29 @@ Status CollaborativeGraph::AddWallWall(std::uint16_t robot_b,
   auto* cost = new ceres::AutoDiffCostFunction<WallWallResidual, 2, 3>(
       new WallWallResidual{a.normal.head<2>() / na, b.normal.head<2>() / nb, a.d / na, b.d / nb,
                            1.0 / sigma_angle, 1.0 / sigma_offset});
+  m.problem->AddResidualBlock(cost, m.huber.get(), r->origin);
+  ++r->factors;
+  ++m.factors;
+  return Ok();
+}
+
+Status CollaborativeGraph::AddOriginMeasurement(std::uint16_t robot_b,
+                                                const Eigen::Isometry3d& T,
+                                                double sigma_m,
+                                                double sigma_rad) {
+  Impl& m = *impl_;
+  Impl::Robot* r = m.Get(robot_b);
+  if (r == nullptr)
+    return Error{Errc::kNotFound, "collaborative graph: robot without an initial origin"};
+  if (!T.matrix().allFinite() || !(sigma_m > 0) || !(sigma_rad > 0)) {
+    return Error{Errc::kInvalidArgument,
+                 "collaborative graph: origin measurement not finite or sigma not positive"};
+  }
+  if (m.factors >= m.config.max_factors)
+    return Error{Errc::kCapacityExceeded, "collaborative graph: factor store full"};
+  auto* cost = new ceres::AutoDiffCostFunction<OriginResidual, 3, 3>(new OriginResidual{
+      T.translation().x(), T.translation().y(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)),
+      1.0 / sigma_m, 1.0 / sigma_rad});
   m.problem->AddResidualBlock(cost, m.huber.get(), r->origin);
   ++r->factors;
   ++m.factors;

@@ -51,6 +51,12 @@ class CollaborativeGraph {
                      const DistilledWall& wall_a,
                      const DistilledWall& wall_b);
 
+  /// A direct measurement of robot b's origin (a fine alignment of one room's clouds).
+  Status AddOriginMeasurement(std::uint16_t robot_b,
+                              const Eigen::Isometry3d& T_self_robot,
+                              double sigma_m,
+                              double sigma_rad);
+
   /// Solves; returns the final cost. Robots without factors keep their initial values.
   Expected<double> Solve();
 

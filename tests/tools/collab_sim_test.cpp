@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+// The full two-robot merge on a simulated office (symmetric rooms included): the simulator
+// records two robots, msgraphs_collab runs both local S-Graphs, distils and exchanges through
+// the wire encodings, matches rooms with fine alignment and the consistency check, and solves
+// robot 1's collaborative graph. Checked here: robot 2 is merged, no accepted match is wrong
+// against the truth, and robot 2's keyframes land on the ground truth in robot 1's frame.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "msgraphs/tools/tum.hpp"
+#include "tool_process.hpp"
+
+namespace msgraphs::test {
+namespace {
+
+TEST(CollabSim, TwoRobotsMergeWithoutAWrongRoomMatch) {
+  const std::string run = Temp("collab_run"), out = Temp("collab_out"), log = Temp("collab_log");
+  std::filesystem::remove_all(run);
+  std::filesystem::remove_all(out);
+  ASSERT_EQ(
+      Wait(Spawn({MSGRAPHS_SIM_TOOL, "--world", MSGRAPHS_OFFICE_WORLD, "--out", run, "--robots",
+                  "2", "--duration-s", "120", "--seed", "1", "--shared-rooms", "2"})),
+      0);
+  ASSERT_EQ(Wait(Spawn({"/bin/sh", "-c",
+                        std::string(MSGRAPHS_COLLAB_TOOL) + " --run " + run + " --out " + out +
+                            " > " + log})),
+            0);
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::printf("%s", text.str().c_str());
+  EXPECT_NE(text.str().find("robot 1 merged 2 of 2 robots"), std::string::npos);
+  EXPECT_NE(text.str().find(" 0 of them wrong against the truth"), std::string::npos);
+  // Robot 2's keyframes in robot 1's frame, against robot 2's truth in the world: the same rigid
+  // alignment that puts robot 1 on its truth must put robot 2 on its own.
+  const auto truth1 = tools::ReadTum(run + "/robot1/ground_truth.tum");
+  const auto truth2 = tools::ReadTum(run + "/robot2/ground_truth.tum");
+  const auto est1 = tools::ReadTum(out + "/robot1_in_robot1.tum");
+  const auto est2 = tools::ReadTum(out + "/robot2_in_robot1.tum");
+  ASSERT_GT(est2.size(), 50u);
+  const auto ate1 = tools::ComputeAte(est1, truth1, 0.006);
+  ASSERT_TRUE(ate1.ok);
+  double sum2 = 0;
+  std::size_t n = 0;
+  for (const auto& p : est2) {
+    if (const auto* t = tools::Nearest(truth2, p.t, 0.006)) {
+      sum2 += (ate1.T_truth_estimate * p.T.translation() - t->T.translation()).squaredNorm();
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 50u);
+  const double rmse2 = std::sqrt(sum2 / static_cast<double>(n));
+  std::printf("robot 1 ATE %.3f m; robot 2 through robot 1's alignment %.3f m\n", ate1.rmse, rmse2);
+  // Robot 2's own map is off by ~9 cm in this short mission (a 40 m corridor and no loop to
+  // close: docs/s-graph.md); a wrong merge would put it metres away.
+  EXPECT_LT(rmse2, 0.15);
+  std::filesystem::remove_all(run);
+  std::filesystem::remove_all(out);
+  std::filesystem::remove(log);
+}
+
+}  // namespace
+}  // namespace msgraphs::test
