@@ -11,9 +11,9 @@
 // aggregated trajectory (every merged robot's keyframes in robot 1's frame through the
 // estimated origins, one SE(3) alignment to the ground truth), room matches accepted and
 // rejected (and how many accepted ones are wrong against the truth), and data exchanged per
-// message type.
+// message type. --mode keyframes runs the keyframe-level baseline instead of rooms.
 //
-//   msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine]
+//   msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes]
 //                   [--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]
 //
 // --out DIR writes robotN_in_robot1.tum: every merged robot's keyframes in robot 1's frame.
@@ -47,13 +47,29 @@ namespace {
 using namespace msgraphs;
 namespace fs = std::filesystem;
 
-enum class Mode { kRooms, kRoomsFine, kRoomsWalls, kRoomsWallsFine };
-bool Fine(Mode m) { return m == Mode::kRoomsFine || m == Mode::kRoomsWallsFine; }
+// kKeyframes is the baseline: keyframe-level inter-robot loop closure as DiSCo-SLAM and
+// Swarm-SLAM exchange it (a Scan Context and the pose of every keyframe; the keyframe cloud on
+// request for verification), through the same fine alignment and consistency check.
+enum class Mode { kRooms, kRoomsFine, kRoomsWalls, kRoomsWallsFine, kKeyframes };
+bool Fine(Mode m) {
+  return m == Mode::kRoomsFine || m == Mode::kRoomsWallsFine || m == Mode::kKeyframes;
+}
 bool Walls(Mode m) { return m == Mode::kRoomsWalls || m == Mode::kRoomsWallsFine; }
 
-enum MessageType { kGraph, kDescriptor, kCloudRequest, kCloud, kMessageTypes };
-const char* kTypeNames[kMessageTypes] = {"distilled graph", "room descriptors",
-                                         "room cloud requests", "room clouds"};
+enum MessageType {
+  kGraph,
+  kDescriptor,
+  kCloudRequest,
+  kCloud,
+  kKeyframeDescriptor,
+  kKeyframeCloud,
+  kMessageTypes
+};
+const char* kTypeNames[kMessageTypes] = {"distilled graph",      "room descriptors",
+                                         "room cloud requests",  "room clouds",
+                                         "keyframe descriptors", "keyframe clouds"};
+constexpr std::size_t kKeyframePoseBytes = 28;  // a keyframe's pose beside its descriptor (7 x f32)
+constexpr float kKeyframeScThreshold = 0.25f;   // keyframe candidates (tighter: many more of them)
 constexpr std::size_t kCloudRequestBytes = 16;  // robot, room, version, CRC
 
 struct RoomDescriptorEntry {
@@ -103,6 +119,12 @@ struct Robot {
   std::uint64_t rejected_anchored = 0, accepted_anchored = 0;
   std::map<int, std::vector<std::uint32_t>> consistent;  // per peer: indices into matches
   core::CollaborativeGraph collab;
+  // Baseline: keyframe descriptors (own), and those received with the sender's pose at the time.
+  std::uint32_t keyframes_sent = 0;
+  std::map<std::uint32_t, core::ScanContext> own_keyframes;
+  std::map<std::pair<int, std::uint32_t>, std::pair<core::ScanContext, Eigen::Isometry3d>>
+      peer_keyframes;
+  std::set<std::pair<int, std::uint32_t>> tried_keyframes;
   std::uint64_t rejected_fine = 0, rejected_consistency = 0;
   std::vector<tools::StampedPose> truth;
 };
@@ -180,6 +202,10 @@ struct Mission {
 
   // Robot `from` distils and sends what changed; descriptors of new or changed rooms.
   void Exchange(Robot& from) {
+    if (mode == Mode::kKeyframes) {
+      ExchangeKeyframes(from);
+      return;
+    }
     from.distiller.Update(from.mapper.graph(), from.mapper.plane_mapper());
     const core::DistilledGraph& g = from.distiller.graph();
     if (g.version > from.sent_version) {
@@ -245,7 +271,82 @@ struct Mission {
   }
 
   // Robot `a` looks for matches between its rooms and the rooms it received.
+  void ExchangeKeyframes(Robot& from) {
+    const core::SGraph& g = from.mapper.graph();
+    const core::ScanContextConfig sc_config{20, 60, 20.0f, 0.5f};  // heights above the floor
+    for (std::uint32_t k = from.keyframes_sent; k < g.keyframe_slots(); ++k) {
+      const auto cloud = from.mapper.keyframe_cloud(k);
+      if (cloud.empty()) continue;
+      core::ScanContext& sc = from.own_keyframes[k];
+      if (!sc.Build(cloud, sc_config)) continue;
+      auto n = core::EncodeRoomDescriptor({static_cast<std::uint16_t>(from.index + 1), k, 0}, sc,
+                                          buffer);
+      if (!n) continue;
+      for (auto& to : robots) {
+        if (to.get() == &from) continue;
+        accounting.Add(kKeyframeDescriptor, from.index, to->index, *n + kKeyframePoseBytes);
+        core::ScanContext received;
+        if (!core::DecodeRoomDescriptor(std::span(buffer.data(), *n), received)) {
+          ++accounting.malformed;
+          continue;
+        }
+        to->peer_keyframes[{from.index, k}] = {received, g.keyframe_pose(k)};
+      }
+    }
+    from.keyframes_sent = static_cast<std::uint32_t>(g.keyframe_slots());
+  }
+
+  void MatchKeyframes(Robot& a) {
+    bool changed = false;
+    for (const auto& [key, theirs] : a.peer_keyframes) {
+      if (!a.tried_keyframes.insert(key).second) continue;
+      // The most alike of our keyframes.
+      float best = 2.0f, yaw = 0.0f;
+      std::uint32_t best_k = 0;
+      for (const auto& [k, mine] : a.own_keyframes) {
+        const auto sc = core::ScanContextDistance(mine, theirs.first);
+        if (sc && sc->distance < best) {
+          best = sc->distance;
+          yaw = sc->yaw_rad;
+          best_k = k;
+        }
+      }
+      if (best > kKeyframeScThreshold) continue;
+      Robot& b = *robots[static_cast<std::size_t>(key.first)];
+      accounting.Add(kCloudRequest, a.index, b.index, kCloudRequestBytes);
+      const auto cloud_b = b.mapper.keyframe_cloud(key.second);
+      core::RoomCloudHeader header{static_cast<std::uint16_t>(b.index + 1), key.second, 0,
+                                   cloud_encoding, 0.01f};
+      auto n = core::EncodeRoomCloud(header, cloud_b, buffer);
+      if (!n) continue;
+      accounting.Add(kKeyframeCloud, b.index, a.index, *n);
+      if (!core::DecodeRoomCloud(std::span(buffer.data(), *n), decoded_cloud)) {
+        ++accounting.malformed;
+        continue;
+      }
+      core::RoomMatch m;
+      m.robot_a = static_cast<std::uint16_t>(a.index + 1);
+      m.robot_b = static_cast<std::uint16_t>(b.index + 1);
+      m.room_a = best_k;
+      m.room_b = key.second;
+      m.sc_distance = best;
+      if (!matcher.FineAlign(a.mapper.keyframe_cloud(best_k),
+                             a.mapper.graph().keyframe_pose(best_k), decoded_cloud.span(),
+                             theirs.second, static_cast<double>(yaw), m)) {
+        ++a.rejected_fine;
+        continue;
+      }
+      a.matches[key.first].push_back(m);
+      changed = true;
+    }
+    if (changed) Solve(a);
+  }
+
   void Match(Robot& a) {
+    if (mode == Mode::kKeyframes) {
+      MatchKeyframes(a);
+      return;
+    }
     bool changed = false;
     for (const auto& [key, theirs] : a.peer_descriptors) {
       const int b_index = key.first;
@@ -343,6 +444,10 @@ struct Mission {
       const core::DistilledGraph& theirs = PeerCopy(a, b_index);
       for (std::uint32_t i : keep) {
         const core::RoomMatch& m = list[i];
+        // A fine alignment measured the origin directly, from the clouds themselves.
+        if (m.fine_aligned)
+          static_cast<void>(a.collab.AddOriginMeasurement(robot_b, m.T_a_b, 0.03, 0.005));
+        if (mode == Mode::kKeyframes) continue;  // the baseline has no rooms or walls
         const core::DistilledRoom* ra = nullptr;
         const core::DistilledRoom* rb = nullptr;
         for (const auto& r : mine.rooms) ra = r.id == m.room_a ? &r : ra;
@@ -350,9 +455,6 @@ struct Mission {
         if (ra == nullptr || rb == nullptr) continue;
         static_cast<void>(
             a.collab.AddRoomRoom(robot_b, ra->centre, ra->yaw_rad, rb->centre, rb->yaw_rad));
-        // A fine alignment measured the origin directly, from the room clouds themselves.
-        if (m.fine_aligned)
-          static_cast<void>(a.collab.AddOriginMeasurement(robot_b, m.T_a_b, 0.03, 0.005));
         if (!Walls(mode)) continue;
         // Pair the two rooms' walls through the match: same facing and offset after T_a_b.
         for (std::int32_t wa : ra->walls) {
@@ -403,6 +505,8 @@ int main(int argc, char** argv) {
         mission.mode = Mode::kRoomsWalls;
       else if (m == "rooms-walls-fine")
         mission.mode = Mode::kRoomsWallsFine;
+      else if (m == "keyframes")
+        mission.mode = Mode::kKeyframes;
       else {
         std::fprintf(stderr, "collab: unknown mode %s\n", m.c_str());
         return 2;
@@ -412,10 +516,10 @@ int main(int argc, char** argv) {
       mission.cloud_encoding =
           c == "f32" ? core::CloudEncoding::kFloat32 : core::CloudEncoding::kQuantised16;
     } else {
-      std::fprintf(
-          stderr,
-          "usage: msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine] "
-          "[--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]\n");
+      std::fprintf(stderr,
+                   "usage: msgraphs_collab --run DIR [--mode "
+                   "rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes] "
+                   "[--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]\n");
       return 2;
     }
   }
@@ -537,7 +641,7 @@ int main(int argc, char** argv) {
   }
   const auto ate = tools::ComputeAte(aggregated, aggregated_truth, 0.5);
   const char* mode_names[] = {"Rooms", "Rooms + fine alignment", "Rooms and walls",
-                              "Rooms and walls + fine alignment"};
+                              "Rooms and walls + fine alignment", "Keyframes (baseline)"};
   const double mb = static_cast<double>(mission.accounting.Total()) / 1e6;
   if (markdown) {
     std::printf("| %s | %zu | %s | %zu / %zu | %.3f | %.3f | %llu / %llu | %llu |\n", run.c_str(),
