@@ -327,7 +327,8 @@ TEST(CollaborativeGraph, RecoversAnotherRobotsOriginFromRoomsAndWalls) {
 
 TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
   SGraph graph;
-  ASSERT_TRUE(graph.Init({}));
+  const SGraphConfig graph_config;
+  ASSERT_TRUE(graph.Init(graph_config));
   PlaneMapper planes;
   ASSERT_TRUE(planes.Init(64, {}));
   // Two keyframes in a 6 x 4 m room see its four walls.
@@ -359,7 +360,7 @@ TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
   for (std::size_t w = 0; w < 4; ++w) room.walls[w] = static_cast<std::int32_t>(ids[w]);
   ASSERT_TRUE(graph.AddRoom(room));
   Distiller distiller;
-  ASSERT_TRUE(distiller.Init(1, 64, {}));
+  ASSERT_TRUE(distiller.Init(1, graph_config, {}));
   ASSERT_TRUE(distiller.Update(graph, planes));
   const DistilledGraph& g = distiller.graph();
   EXPECT_EQ(g.version, 1u);

@@ -199,6 +199,11 @@ struct Mission {
   Accounting accounting;
   std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(8 << 20);
   BoundedVector<Eigen::Vector3f> decoded_cloud{200000}, cloud_scratch{200000};
+  core::DistilledGraph delta = [] {  // a received message, decoded before it is merged
+    core::DistilledGraph g;
+    g.Init(4096, 512);
+    return g;
+  }();
 
   // Robot `from` distils and sends what changed; descriptors of new or changed rooms.
   void Exchange(Robot& from) {
@@ -215,8 +220,6 @@ struct Mission {
           if (to.get() == &from) continue;
           accounting.Add(kGraph, from.index, to->index, *n);
           core::DistilledGraph& copy = PeerCopy(*to, from.index);
-          core::DistilledGraph delta;
-          delta.Init(4096, 512);
           if (!core::DecodeDistilled(std::span(buffer.data(), *n), delta, &copy) ||
               !core::ApplyDistilled(delta, copy)) {
             ++accounting.malformed;
@@ -542,7 +545,7 @@ int main(int argc, char** argv) {
     r->candump.emplace(std::move(*candump));
     core::LocalMapperConfig config;
     if (!r->mapper.Init(config) ||
-        !r->distiller.Init(static_cast<std::uint16_t>(i + 1), config.graph.max_planes, {}) ||
+        !r->distiller.Init(static_cast<std::uint16_t>(i + 1), config.graph, {}) ||
         !r->descriptor_builder.Init({}) || !r->collab.Init({})) {
       return 1;
     }

@@ -14,14 +14,16 @@ Status DistillerConfig::Validate() const {
   return Ok();
 }
 
-Status Distiller::Init(std::uint16_t robot, std::size_t max_planes, const DistillerConfig& config) {
+Status Distiller::Init(std::uint16_t robot,
+                       const SGraphConfig& graph,
+                       const DistillerConfig& config) {
   if (auto s = config.Validate(); !s) return s;
   config_ = config;
   out_.Init(config.max_walls, config.max_rooms);
   out_.robot = robot;
-  wall_slot_.assign(max_planes, -1);
-  room_slot_.assign(config.max_rooms * 4, -1);
-  needed_.assign(max_planes, 0);
+  wall_slot_.assign(graph.max_planes, -1);
+  room_slot_.assign(graph.max_rooms, -1);
+  needed_.assign(graph.max_planes, 0);
   return Ok();
 }
 

@@ -7,22 +7,28 @@ namespace msgraphs::core {
 namespace {
 constexpr std::int64_t kHalfRange = 1 << 20;
 
-std::uint64_t Hash(std::uint64_t key) {
-  key ^= key >> 33;
-  key *= 0xFF51AFD7ED558CCDull;
-  key ^= key >> 33;
-  return key;
-}
 }  // namespace
 
-bool VoxelKey(const Eigen::Vector3f& p, float inverse_leaf, std::uint64_t& key) {
+bool PackVoxelCoordinates(std::int64_t x, std::int64_t y, std::int64_t z, std::uint64_t& key) {
   key = 0;
+  const std::int64_t c[3] = {x, y, z};
   for (int a = 0; a < 3; ++a) {
-    const float c = std::floor(p[a] * inverse_leaf);
-    if (!(c > -static_cast<float>(kHalfRange) && c < static_cast<float>(kHalfRange - 1))) return false;  // NaN too
-    key |= static_cast<std::uint64_t>(static_cast<std::int64_t>(c) + kHalfRange) << (21 * a);
+    if (c[a] <= -kHalfRange || c[a] >= kHalfRange - 1) return false;
+    key |= static_cast<std::uint64_t>(c[a] + kHalfRange) << (21 * a);
   }
   return true;
+}
+
+bool VoxelKey(const Eigen::Vector3f& p, float inverse_leaf, std::uint64_t& key) {
+  std::int64_t c[3];
+  for (int a = 0; a < 3; ++a) {
+    const float f = std::floor(p[a] * inverse_leaf);
+    // Range-checked in float first: a NaN or huge value must not reach the integer conversion.
+    if (!(f > -static_cast<float>(kHalfRange) && f < static_cast<float>(kHalfRange - 1)))
+      return false;
+    c[a] = static_cast<std::int64_t>(f);
+  }
+  return PackVoxelCoordinates(c[0], c[1], c[2], key);
 }
 
 void VoxelDownsampler::Init(std::size_t max_voxels) {
@@ -37,12 +43,14 @@ void VoxelDownsampler::Init(std::size_t max_voxels) {
   peak_ = 0;
 }
 
-Status VoxelDownsampler::Downsample(std::span<const Eigen::Vector3f> points, float leaf_m,
+Status VoxelDownsampler::Downsample(std::span<const Eigen::Vector3f> points,
+                                    float leaf_m,
                                     BoundedVector<Eigen::Vector3f>& out) {
   out.clear();
   stats_ = {};
   stats_.input = points.size();
-  if (!(leaf_m > 0.0f) || !std::isfinite(leaf_m)) return Error{Errc::kInvalidArgument, "voxel grid: leaf must be > 0"};
+  if (!(leaf_m > 0.0f) || !std::isfinite(leaf_m))
+    return Error{Errc::kInvalidArgument, "voxel grid: leaf must be > 0"};
   if (sum_.empty()) return Error{Errc::kInvalidArgument, "voxel grid: Init was not called"};
   if (++epoch_ == 0) {  // wrapped: forget every slot explicitly
     std::fill(slot_epoch_.begin(), slot_epoch_.end(), 0);
@@ -57,7 +65,7 @@ Status VoxelDownsampler::Downsample(std::span<const Eigen::Vector3f> points, flo
       ++stats_.rejected;
       continue;
     }
-    std::size_t slot = Hash(key) & mask;
+    std::size_t slot = VoxelHash(key) & mask;
     while (slot_epoch_[slot] == epoch_ && keys_[slot] != key) slot = (slot + 1) & mask;
     if (slot_epoch_[slot] != epoch_) {
       if (used == sum_.size()) {
@@ -82,11 +90,15 @@ Status VoxelDownsampler::Downsample(std::span<const Eigen::Vector3f> points, flo
     }
   }
   stats_.output = out.size();
-  if (stats_.overflowed > 0) return Error{Errc::kCapacityExceeded, "voxel grid: more voxels than capacity; extra points dropped"};
+  if (stats_.overflowed > 0)
+    return Error{Errc::kCapacityExceeded,
+                 "voxel grid: more voxels than capacity; extra points dropped"};
   return Ok();
 }
 
-RangeFilterStats RangeFilter(std::span<const Eigen::Vector3f> points, float min_range_m, float max_range_m,
+RangeFilterStats RangeFilter(std::span<const Eigen::Vector3f> points,
+                             float min_range_m,
+                             float max_range_m,
                              BoundedVector<Eigen::Vector3f>& out) {
   out.clear();
   RangeFilterStats s;

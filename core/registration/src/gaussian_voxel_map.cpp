@@ -4,28 +4,30 @@
 #include <algorithm>
 #include <cmath>
 
+#include "msgraphs/core/perception/voxel_grid.hpp"
+
 namespace msgraphs::core {
 namespace {
-constexpr std::int64_t kHalfRange = 1 << 20;
 
-bool Key(const Eigen::Vector3d& p, double inverse_resolution, int dx, int dy, int dz, std::uint64_t& key) {
-  const std::int64_t c[3] = {static_cast<std::int64_t>(std::floor(p.x() * inverse_resolution)) + dx,
-                             static_cast<std::int64_t>(std::floor(p.y() * inverse_resolution)) + dy,
-                             static_cast<std::int64_t>(std::floor(p.z() * inverse_resolution)) + dz};
-  key = 1ull << 63;  // never 0
-  for (int a = 0; a < 3; ++a) {
-    if (c[a] <= -kHalfRange || c[a] >= kHalfRange - 1) return false;
-    key |= static_cast<std::uint64_t>(c[a] + kHalfRange) << (21 * a);
+// The packed voxel key with bit 63 set, so that 0 marks an empty slot. Coordinates are computed
+// in double (map-sized clouds at fine resolutions), range-checked before the conversion.
+bool Key(const Eigen::Vector3d& p,
+         double inverse_resolution,
+         int dx,
+         int dy,
+         int dz,
+         std::uint64_t& key) {
+  const Eigen::Vector3d f = (p * inverse_resolution).array().floor();
+  if (!(f.cwiseAbs().maxCoeff() < 1e9)) return false;  // NaN too
+  if (!PackVoxelCoordinates(static_cast<std::int64_t>(f.x()) + dx,
+                            static_cast<std::int64_t>(f.y()) + dy,
+                            static_cast<std::int64_t>(f.z()) + dz, key)) {
+    return false;
   }
+  key |= 1ull << 63;
   return true;
 }
 
-std::uint64_t Hash(std::uint64_t key) {
-  key ^= key >> 33;
-  key *= 0xFF51AFD7ED558CCDull;
-  key ^= key >> 33;
-  return key;
-}
 }  // namespace
 
 void GaussianVoxelMap::Init(std::size_t max_voxels) {
@@ -39,18 +41,21 @@ void GaussianVoxelMap::Init(std::size_t max_voxels) {
 
 std::size_t GaussianVoxelMap::Find(std::uint64_t key) const {
   const std::size_t mask = keys_.size() - 1;
-  std::size_t slot = Hash(key) & mask;
+  std::size_t slot = VoxelHash(key) & mask;
   while (keys_[slot] != 0 && keys_[slot] != key) slot = (slot + 1) & mask;
   return slot;
 }
 
-Status GaussianVoxelMap::Build(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Matrix3f> covariances,
+Status GaussianVoxelMap::Build(std::span<const Eigen::Vector3f> points,
+                               std::span<const Eigen::Matrix3f> covariances,
                                double resolution_m) {
   std::fill(keys_.begin(), keys_.end(), 0);
   used_ = 0;
   if (voxels_.empty()) return Error{Errc::kInvalidArgument, "voxel map: Init was not called"};
-  if (!(resolution_m > 0.0) || !std::isfinite(resolution_m)) return Error{Errc::kInvalidArgument, "voxel map: resolution must be > 0"};
-  if (points.size() != covariances.size()) return Error{Errc::kInvalidArgument, "voxel map: one covariance per point"};
+  if (!(resolution_m > 0.0) || !std::isfinite(resolution_m))
+    return Error{Errc::kInvalidArgument, "voxel map: resolution must be > 0"};
+  if (points.size() != covariances.size())
+    return Error{Errc::kInvalidArgument, "voxel map: one covariance per point"};
   resolution_ = resolution_m;
   const double inverse = 1.0 / resolution_m;
   bool overflow = false;
@@ -82,13 +87,18 @@ Status GaussianVoxelMap::Build(std::span<const Eigen::Vector3f> points, std::spa
   return Ok();
 }
 
-const GaussianVoxel* GaussianVoxelMap::Lookup(const Eigen::Vector3d& p, int dx, int dy, int dz) const {
+const GaussianVoxel* GaussianVoxelMap::Lookup(const Eigen::Vector3d& p,
+                                              int dx,
+                                              int dy,
+                                              int dz) const {
   std::uint64_t key = 0;
   if (used_ == 0 || !Key(p, 1.0 / resolution_, dx, dy, dz, key)) return nullptr;
   const std::size_t slot = Find(key);
   return keys_[slot] == 0 ? nullptr : &voxels_[slot_value_[slot]];
 }
 
-const GaussianVoxel* GaussianVoxelMap::Lookup(const Eigen::Vector3d& p) const { return Lookup(p, 0, 0, 0); }
+const GaussianVoxel* GaussianVoxelMap::Lookup(const Eigen::Vector3d& p) const {
+  return Lookup(p, 0, 0, 0);
+}
 
 }  // namespace msgraphs::core

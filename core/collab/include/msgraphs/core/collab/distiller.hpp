@@ -30,7 +30,8 @@ struct DistillerConfig {
 
 class Distiller {
  public:
-  Status Init(std::uint16_t robot, std::size_t max_planes, const DistillerConfig& config);
+  /// `graph` gives the capacities of the S-Graph it will distil (its plane and room ids).
+  Status Init(std::uint16_t robot, const SGraphConfig& graph, const DistillerConfig& config);
 
   /// Refreshes the distilled graph from the local one; true when something changed (the graph's
   /// version then went up and the changed elements carry it).
@@ -42,7 +43,7 @@ class Distiller {
   DistillerConfig config_;
   DistilledGraph out_;
   std::vector<std::int32_t> wall_slot_;  // local plane id -> index in out_.walls, -1 if absent
-  std::vector<std::int32_t> room_slot_;  // local room id -> index in out_.rooms
+  std::vector<std::int32_t> room_slot_;  // local room id -> index in out_.rooms, -1 if absent
   std::vector<std::uint8_t> needed_;     // per local plane: a room uses it
 };
 

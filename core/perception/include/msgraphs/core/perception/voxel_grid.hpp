@@ -15,9 +15,21 @@
 
 namespace msgraphs::core {
 
-/// Voxel key: integer coordinates packed into 63 bits (21 bits each, +-2^20 voxels per axis).
-/// false when the point is too far out (|coordinate| / leaf >= 2^20) or not finite.
+/// Integer voxel coordinates packed into 63 bits (21 bits each, +-2^20 voxels per axis); false
+/// when one is out of that range. The one packing every voxel table uses.
+bool PackVoxelCoordinates(std::int64_t x, std::int64_t y, std::int64_t z, std::uint64_t& key);
+
+/// Voxel key of a point: false when it is too far out (|coordinate| / leaf >= 2^20) or not finite.
 bool VoxelKey(const Eigen::Vector3f& p, float inverse_leaf, std::uint64_t& key);
+
+/// Slot hash for open-addressing tables keyed by voxel keys (MurmurHash3's 64-bit finaliser,
+/// first half): packed keys differ in few high bits, so they are mixed before masking.
+inline std::uint64_t VoxelHash(std::uint64_t key) {
+  key ^= key >> 33;
+  key *= 0xFF51AFD7ED558CCDull;
+  key ^= key >> 33;
+  return key;
+}
 
 struct VoxelGridStats {
   std::size_t input = 0;
@@ -32,7 +44,9 @@ class VoxelDownsampler {
   std::size_t capacity() const { return sum_.size(); }
 
   /// Appends the centroids to `out` (cleared first). kInvalidArgument for a leaf <= 0.
-  Status Downsample(std::span<const Eigen::Vector3f> points, float leaf_m, BoundedVector<Eigen::Vector3f>& out);
+  Status Downsample(std::span<const Eigen::Vector3f> points,
+                    float leaf_m,
+                    BoundedVector<Eigen::Vector3f>& out);
   const VoxelGridStats& stats() const { return stats_; }
   std::size_t peak_voxels() const { return peak_; }
 
@@ -52,7 +66,9 @@ class VoxelDownsampler {
 struct RangeFilterStats {
   std::size_t kept = 0, out_of_range = 0, non_finite = 0, overflowed = 0;
 };
-RangeFilterStats RangeFilter(std::span<const Eigen::Vector3f> points, float min_range_m, float max_range_m,
+RangeFilterStats RangeFilter(std::span<const Eigen::Vector3f> points,
+                             float min_range_m,
+                             float max_range_m,
                              BoundedVector<Eigen::Vector3f>& out);
 
 }  // namespace msgraphs::core
