@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: arbitrary bytes as another robot's message. The first byte picks the kind
-// (distilled graph, room descriptor, room cloud); the rest is the message body, to which the
-// correct CRC-32 is appended so that the parsers past the checksum are exercised (a wrong CRC
-// alone is rejected at once). Invariants: no crash; whatever decodes is finite, within the
-// receiver's capacity, with unit wall normals, and merges into a copy.
+// (distilled graph, room descriptor, room cloud, room cloud request); the rest is the message body,
+// to which the correct CRC-32 is appended so that the parsers past the checksum are exercised (a
+// wrong CRC alone is rejected at once). Invariants: no crash; whatever decodes is finite, within
+// the receiver's capacity, with unit wall normals, and merges into a copy.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -24,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   WriteU32Le(message.data() + message.size() - 4,
              Crc32(std::span(message.data(), message.size() - 4)));
   const std::span<const std::uint8_t> bytes(message);
-  switch (data[0] % 3) {
+  switch (data[0] % 4) {
     case 0: {
       static DistilledGraph known, out;
       static bool init = false;
@@ -39,7 +39,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (!w.normal.allFinite() || std::fabs(w.normal.norm() - 1.0) > 1e-6 || !std::isfinite(w.d))
           std::abort();
       }
-      if (out.has_floor && !out.floor_centre.allFinite()) std::abort();
+      if (out.has_floor && (!out.floor_centre.allFinite() || !std::isfinite(out.floor_z_m)))
+        std::abort();
       static_cast<void>(ApplyDistilled(out, known));
       if (known.walls.size() > known.walls.capacity()) std::abort();
       break;
@@ -52,6 +53,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           if (!std::isfinite(sc.cell(r, s))) std::abort();
         }
       }
+      break;
+    }
+    case 2: {
+      auto q = DecodeRoomCloudRequest(bytes);
+      if (q && (q->from == 0 || q->to == 0 || q->from == q->to)) std::abort();
       break;
     }
     default: {

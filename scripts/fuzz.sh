@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-60}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session)
 DATA=${MSGRAPHS_DATA_DIR:-$(pwd)/../shared/data}
 
 cmake --preset fuzz >/dev/null
@@ -18,7 +18,7 @@ cmake --build --preset fuzz >/dev/null
 
 WORK=$(mktemp -d); trap 'rm -rf "$WORK"' EXIT
 mkdir -p build/fuzz/artifacts
-mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages}
+mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session}
 if [ -d "$DATA/pcap" ]; then
   # Single packets of the einride recording, and the small captures whole.
   python3 - "$DATA/pcap/einride_vlp16_recording_1000pkts.bin" "$WORK/velodyne_decoder" <<'PY'
@@ -36,20 +36,23 @@ fi
 printf '(1700000000.123456) can0 120#1A2B3C4D5E6F7788\n(1700000000.123456789) vcan0 12345678#R\n(1.000000) can1 14C##5AABB\n' \
   > "$WORK/candump_parser/handmade.log"
 
-# Seeds for the collaboration messages: one valid message of each kind (kind byte, body; the
-# target appends the CRC).
+# Seeds for the collaboration messages and the session: one valid message of each kind (kind
+# byte as CollabMessageType, body; the targets append the CRC).
 python3 - "$WORK/collab_messages" <<'PY'
 import struct, sys
 d = sys.argv[1]
 wall = struct.pack('<II3ffffffffffff', 7, 2, 1.0, 0.0, 0.0, -2.0, 1e-4, 0, 0, 1e-4, 0, 1e-4, 2.0, -1.0, 2.0, 1.0)
 room = struct.pack('<IIBfffffiiii', 3, 2, 0, 1.0, 2.0, 0.1, 4.0, 5.0, 7, 7, 7, 7)
-graph = b'MSDG' + struct.pack('<BBHIIHH', 1, 1, 2, 2, 0, 1, 1) + struct.pack('<ff', 0.5, 0.5) + wall + room
+graph = b'MSDG' + struct.pack('<BBHIIHH', 1, 1, 2, 2, 0, 1, 1) + struct.pack('<fff', 0.5, 0.5, -0.5) + wall + room
 open(f"{d}/graph", 'wb').write(b'\x00' + graph)
 desc = b'MSRD' + struct.pack('<BHIIBBf', 1, 2, 3, 2, 2, 3, 12.0) + bytes([10, 20, 30, 40, 50, 60])
 open(f"{d}/descriptor", 'wb').write(b'\x01' + desc)
 cloud = b'MSRC' + struct.pack('<BBHIIfI', 1, 1, 2, 3, 2, 0.01, 2) + struct.pack('<6h', 1, 2, 3, -4, -5, -6)
-open(f"{d}/cloud", 'wb').write(b'\x02' + cloud)
+open(f"{d}/cloud", 'wb').write(b'\x03' + cloud)
+request = b'MSRQ' + struct.pack('<BHHII', 1, 2, 1, 3, 2)
+open(f"{d}/request", 'wb').write(b'\x02' + request)
 PY
+cp "$WORK"/collab_messages/* "$WORK/collab_session/"
 
 status=0
 for t in "${TARGETS[@]}"; do

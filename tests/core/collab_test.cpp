@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
 #include "msgraphs/base/byte_order.hpp"
 #include "msgraphs/base/crc32.hpp"
+#include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/collab/distilled_codec.hpp"
 #include "msgraphs/core/collab/distiller.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
@@ -74,7 +76,8 @@ TEST(DistilledCodec, RoundTripsAndSendsOnlyWhatChanged) {
   auto n = EncodeDistilled(g, 0, buffer);
   ASSERT_TRUE(n);
   EXPECT_EQ(*n, DistilledEncodedSize(g, 0));
-  EXPECT_EQ(*n, kDistilledHeaderBytes + 8 + 8 * kDistilledWallBytes + 2 * kDistilledRoomBytes + 4);
+  EXPECT_EQ(*n, kDistilledHeaderBytes + kDistilledFloorBytes + 8 * kDistilledWallBytes +
+                    2 * kDistilledRoomBytes + 4);
   DistilledGraph out;
   out.Init(16, 4);
   auto delta = DecodeDistilled(std::span(buffer.data(), *n), out);
@@ -95,7 +98,8 @@ TEST(DistilledCodec, RoundTripsAndSendsOnlyWhatChanged) {
   // Since version 3, only the second room and its walls travel; they may refer to known walls.
   auto d = EncodeDistilled(g, 3, buffer);
   ASSERT_TRUE(d);
-  EXPECT_EQ(*d, kDistilledHeaderBytes + 8 + 4 * kDistilledWallBytes + kDistilledRoomBytes + 4);
+  EXPECT_EQ(*d, kDistilledHeaderBytes + kDistilledFloorBytes + 4 * kDistilledWallBytes +
+                    kDistilledRoomBytes + 4);
   DistilledGraph copy;
   copy.Init(16, 4);
   ASSERT_TRUE(ApplyDistilled(out, copy));
@@ -148,23 +152,23 @@ TEST(DistilledCodec, RejectsMalformedInputWithAReason) {
   const float two = 2.0f;
   std::uint32_t bits;
   std::memcpy(&bits, &two, 4);
-  WriteU32Le(&normal[20 + 8 + 8], bits);  // first wall's normal x
+  WriteU32Le(&normal[20 + kDistilledFloorBytes + 8], bits);  // first wall's normal x
   Reseal(normal);
   expect(normal, Errc::kMalformed);
   auto nan = good;
   const float q = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(&bits, &q, 4);
-  WriteU32Le(&nan[20 + 8 + 8 + 12], bits);  // first wall's d
+  WriteU32Le(&nan[20 + kDistilledFloorBytes + 8 + 12], bits);  // first wall's d
   Reseal(nan);
   expect(nan, Errc::kMalformed);
   auto covariance = good;
   const float negative = -1.0f;
   std::memcpy(&bits, &negative, 4);
-  WriteU32Le(&covariance[20 + 8 + 8 + 16], bits);  // first wall's covariance xx
+  WriteU32Le(&covariance[20 + kDistilledFloorBytes + 8 + 16], bits);  // first wall's covariance xx
   Reseal(covariance);
   expect(covariance, Errc::kMalformed);
   auto unknown_wall = good;
-  const std::size_t room0 = 20 + 8 + 8 * kDistilledWallBytes;
+  const std::size_t room0 = 20 + kDistilledFloorBytes + 8 * kDistilledWallBytes;
   WriteU32Le(&unknown_wall[room0 + 29], 999);  // the first room's first wall id
   Reseal(unknown_wall);
   expect(unknown_wall, Errc::kMalformed);
@@ -212,6 +216,25 @@ TEST(RoomMessages, DescriptorsAndCloudsRoundTripCompactly) {
     }
   }
   EXPECT_EQ(RoomCloudEncodedSize(CloudEncoding::kQuantised16, 1000) - 28, 6000u);
+  // 8 bits at 5 cm: 3 bytes a point, within 2.5 cm per axis; a point beyond +-6.35 m is refused.
+  {
+    std::vector<Eigen::Vector3f> room;
+    for (const Eigen::Vector3f& q : cloud) {
+      if (q.cwiseAbs().maxCoeff() < 6.3f) room.push_back(q);
+    }
+    ASSERT_FALSE(room.empty());
+    auto c8 = EncodeRoomCloud({2, 7, 4, CloudEncoding::kQuantised8, 0.05f}, room, buffer);
+    ASSERT_TRUE(c8);
+    EXPECT_EQ(*c8, 28 + 3 * room.size());
+    ASSERT_TRUE(DecodeRoomCloud(std::span(buffer.data(), *c8), points));
+    ASSERT_EQ(points.size(), room.size());
+    for (std::size_t i = 0; i < room.size(); ++i)
+      EXPECT_LE((points[i] - room[i]).cwiseAbs().maxCoeff(), 0.0251f);
+    const std::vector<Eigen::Vector3f> wide{Eigen::Vector3f(6.5f, 0, 0)};
+    EXPECT_EQ(
+        EncodeRoomCloud({2, 7, 4, CloudEncoding::kQuantised8, 0.05f}, wide, buffer).error().code,
+        Errc::kInvalidArgument);
+  }
   // Bad input: CRC, capacity, length, a point beyond the quantised range.
   auto c = *EncodeRoomCloud({2, 7, 4, CloudEncoding::kQuantised16, 0.01f}, cloud, buffer);
   std::vector<std::uint8_t> m(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(c));
@@ -294,35 +317,70 @@ TEST(RoomMatcher, FineAlignmentRecoversTheMapToMapTransform) {
   EXPECT_LT((truth.inverse() * m2.T_a_b).translation().norm(), 0.02);
 }
 
-TEST(CollaborativeGraph, RecoversAnotherRobotsOriginFromRoomsAndWalls) {
-  const Eigen::Isometry3d truth = Planar(7.0, -3.0, 1.1);  // robot 2's map in robot 1's
+TEST(CollaborativeGraph, RecoversAnotherRobotsSE3OriginFromRoomsAndWalls) {
+  // Robot 2's map in robot 1's: a planar offset and a different height (robot 2 started on a
+  // step: its floor is 0.7 m below its map origin, robot 1's 0.5 m).
+  Eigen::Isometry3d truth = Planar(7.0, -3.0, 1.1);
+  truth.translation().z() = 0.2;
+  const double floor_a = -0.5, floor_b = -0.7;
   DistilledGraph a, b;
   a.Init(16, 4);
   b.Init(16, 4);
   AddRoom(a, 0, 0, Planar(2, 3, 0.3), 1);
   AddRoom(a, 4, 1, Planar(10, 2, 0.3), 1);
-  AddRoom(b, 0, 0, truth.inverse() * Planar(2, 3, 0.3), 1);
-  AddRoom(b, 4, 1, truth.inverse() * Planar(10, 2, 0.3), 1);
+  AddRoom(b, 10, 5, truth.inverse() * Planar(2, 3, 0.3), 1);
+  AddRoom(b, 14, 6, truth.inverse() * Planar(10, 2, 0.3), 1);
+  // What a room match suggests: off by 30 cm, 3 degrees of yaw and a degree of roll.
+  const Eigen::Isometry3d initial =
+      truth * Planar(0.3, -0.2, 0.05) * Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX());
   for (bool walls : {false, true}) {
     CollaborativeGraph g;
-    ASSERT_TRUE(g.Init({}));
-    ASSERT_TRUE(g.SetInitial(2, truth * Planar(0.3, -0.2, 0.05)));  // what a room match suggests
+    ASSERT_TRUE(g.Init({}, 1));
+    ASSERT_TRUE(g.SetInitial(2, initial));
+    std::uint32_t wall_nodes[2][8];
     for (std::size_t r = 0; r < 2; ++r) {
-      ASSERT_TRUE(g.AddRoomRoom(2, a.rooms[r].centre, a.rooms[r].yaw_rad, b.rooms[r].centre,
-                                b.rooms[r].yaw_rad));
+      auto ra = g.AddRoom(1, a.rooms[r], floor_a);
+      auto rb = g.AddRoom(2, b.rooms[r], floor_b);
+      ASSERT_TRUE(ra && rb);
+      ASSERT_TRUE(g.AddRoomRoom(*ra, *rb));
       if (!walls) continue;
-      for (std::size_t w = 0; w < 4; ++w)
-        ASSERT_TRUE(g.AddWallWall(2, a.walls[r * 4 + w], b.walls[r * 4 + w]));
+      for (std::size_t w = 0; w < 4; ++w) {
+        auto wa = g.AddWall(1, a.walls[r * 4 + w]);
+        auto wb = g.AddWall(2, b.walls[r * 4 + w]);
+        ASSERT_TRUE(wa && wb);
+        wall_nodes[0][r * 4 + w] = *wa;
+        wall_nodes[1][r * 4 + w] = *wb;
+        ASSERT_TRUE(g.AddWallWall(*wa, *wb));
+      }
     }
     ASSERT_TRUE(g.Solve());
     const Eigen::Isometry3d e = truth.inverse() * g.T_self_robot(2);
     EXPECT_LT(e.translation().norm(), 1e-3) << (walls ? "rooms and walls" : "rooms");
-    EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 1e-4);
+    EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 1e-4) << (walls ? "rooms and walls" : "rooms");
+    EXPECT_EQ(g.rooms(), 4u);
+    EXPECT_LT((g.room_centre(1) - Eigen::Vector3d(2, 3, floor_a)).norm(), 1e-3);
+    if (!walls) continue;
+    // Robot 2's walls, refined and expressed in robot 1's frame, are robot 1's walls.
+    EXPECT_EQ(g.walls(), 16u);
+    for (std::size_t w = 0; w < 8; ++w) {
+      const DistilledWall mine = g.wall(wall_nodes[0][w]), theirs = g.wall(wall_nodes[1][w]);
+      EXPECT_EQ(g.wall_robot(wall_nodes[1][w]), 2);
+      EXPECT_GT(theirs.normal.dot(a.walls[w].normal), std::cos(1e-4));
+      EXPECT_NEAR(theirs.d, a.walls[w].d, 1e-3);
+      EXPECT_NEAR(mine.d, a.walls[w].d, 1e-3);
+      EXPECT_EQ(theirs.id, b.walls[w].id);
+    }
   }
   CollaborativeGraph g;
-  ASSERT_TRUE(g.Init({}));
-  EXPECT_FALSE(g.AddRoomRoom(3, {0, 0}, 0, {0, 0}, 0));  // no initial origin for robot 3
-  EXPECT_FALSE(g.SetInitial(99, truth));                 // beyond max_robots
+  ASSERT_TRUE(g.Init({}, 1));
+  EXPECT_FALSE(g.AddRoom(3, a.rooms[0], floor_a));  // no initial origin for robot 3
+  EXPECT_FALSE(g.SetInitial(99, truth));            // beyond max_robots
+  EXPECT_FALSE(g.SetInitial(1, truth));             // self is the gauge
+  EXPECT_FALSE(g.AddRoomRoom(0, 1));                // no such nodes
+  DistilledWall bad = a.walls[0];
+  bad.d = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(g.AddWall(1, bad));
+  EXPECT_FALSE(g.Init({}, 0));  // robot ids start at 1
 }
 
 TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
@@ -382,4 +440,134 @@ TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
 }
 
 }  // namespace
+
+namespace {
+
+struct RecordingOutbox final : CollabOutbox {
+  struct Sent {
+    CollabMessageType type;
+    std::uint16_t to;
+    std::vector<std::uint8_t> bytes;
+  };
+  std::vector<Sent> sent;
+  void Send(CollabMessageType type,
+            std::uint16_t to,
+            std::span<const std::uint8_t> bytes) override {
+    sent.push_back({type, to, {bytes.begin(), bytes.end()}});
+  }
+};
+
+std::vector<std::uint8_t> EncodedGraph(const DistilledGraph& g, std::uint32_t since) {
+  std::vector<std::uint8_t> bytes(64 * 1024);
+  auto n = EncodeDistilled(g, since, bytes);
+  EXPECT_TRUE(n);
+  bytes.resize(n ? *n : 0);
+  return bytes;
+}
+
+}  // namespace
+
+TEST(CollabSession, CountsAndRefusesBadOrHostileMessagesAndKeepsWorking) {
+  CollabSessionConfig config;
+  config.robot = 1;
+  config.max_peers = 2;
+  CollabSession session;
+  ASSERT_TRUE(session.Init(config, SGraphConfig{}, -0.5));
+  RecordingOutbox out;
+
+  // A peer's distilled graph arrives and is held.
+  DistilledGraph g;
+  g.Init(16, 4);
+  g.robot = 2;
+  AddRoom(g, 0, 0, Planar(2, 3, 0.3), 1);
+  g.version = 1;
+  g.has_floor = true;
+  g.floor_z_m = -0.6;
+  auto bytes = EncodedGraph(g, 0);
+  ASSERT_TRUE(session.Receive(CollabMessageType::kDistilledGraph, bytes, out));
+  ASSERT_NE(session.peer_graph(2), nullptr);
+  EXPECT_EQ(session.peer_graph(2)->walls.size(), 4u);
+  EXPECT_DOUBLE_EQ(session.peer_graph(2)->floor_z_m, static_cast<double>(-0.6f));
+  EXPECT_EQ(session.peer_stats(0).bytes_received[0], bytes.size());
+
+  // A flipped bit fails the CRC: counted against the peer, nothing changes.
+  auto corrupt = bytes;
+  corrupt[30] ^= 0x10;
+  EXPECT_FALSE(session.Receive(CollabMessageType::kDistilledGraph, corrupt, out));
+  EXPECT_EQ(session.stats().malformed, 1u);
+  EXPECT_EQ(session.peer_stats(0).malformed, 1u);
+  // A message claiming to come from ourselves, and one whose type lies about its content.
+  g.robot = 1;
+  EXPECT_FALSE(session.Receive(CollabMessageType::kDistilledGraph, EncodedGraph(g, 0), out));
+  EXPECT_FALSE(session.Receive(CollabMessageType::kRoomCloud, bytes, out));
+  EXPECT_EQ(session.stats().malformed, 3u);
+
+  // A delta whose base was never received is applied and counted as a gap.
+  g.robot = 2;
+  g.version = 5;
+  g.walls[0].version = 5;
+  g.walls[0].d += 0.1;
+  EXPECT_TRUE(session.Receive(CollabMessageType::kDistilledGraph, EncodedGraph(g, 3), out));
+  EXPECT_EQ(session.peer_stats(0).graph_gaps, 1u);
+  EXPECT_NEAR(session.peer_graph(2)->walls[0].d, g.walls[0].d, 1e-6);
+
+  // Peers beyond max_peers are refused with a counter.
+  for (int robot : {3, 4}) {
+    g.robot = static_cast<std::uint16_t>(robot);
+    static_cast<void>(session.Receive(CollabMessageType::kDistilledGraph, EncodedGraph(g, 0), out));
+  }
+  EXPECT_EQ(session.peers(), 2u);
+  EXPECT_EQ(session.stats().peers_refused, 1u);
+
+  // A descriptor of another shape than ours cannot be compared: refused with a reason.
+  ScanContext sc;
+  const std::vector<Eigen::Vector3f> points = {{1, 0, 1}, {0, 2, 0.5f}, {-1, -1, 2}};
+  ASSERT_TRUE(sc.Build(points, {10, 30, 12.0f, 0.0f}));
+  std::vector<std::uint8_t> descriptor(RoomDescriptorEncodedSize(sc));
+  ASSERT_TRUE(EncodeRoomDescriptor({2, 0, 1}, sc, descriptor));
+  EXPECT_FALSE(session.Receive(CollabMessageType::kRoomDescriptor, descriptor, out));
+  EXPECT_EQ(session.stats().descriptors_mismatched, 1u);
+
+  // Requests: for a room we do not have (counted), for another robot (ignored, not an error).
+  std::vector<std::uint8_t> request(kRoomCloudRequestBytes);
+  ASSERT_TRUE(EncodeRoomCloudRequest({2, 1, 42, 1}, request));
+  EXPECT_FALSE(session.Receive(CollabMessageType::kRoomCloudRequest, request, out));
+  EXPECT_EQ(session.stats().requests_unknown, 1u);
+  ASSERT_TRUE(EncodeRoomCloudRequest({2, 3, 42, 1}, request));
+  EXPECT_TRUE(session.Receive(CollabMessageType::kRoomCloudRequest, request, out));
+  EXPECT_TRUE(out.sent.empty());
+
+  // A room cloud nobody asked for is not cached.
+  std::vector<std::uint8_t> cloud(RoomCloudEncodedSize(CloudEncoding::kQuantised16, 3));
+  ASSERT_TRUE(EncodeRoomCloud({2, 0, 1, CloudEncoding::kQuantised16, 0.01f}, points, cloud));
+  EXPECT_FALSE(session.Receive(CollabMessageType::kRoomCloud, cloud, out));
+  EXPECT_EQ(session.stats().clouds_unsolicited, 1u);
+
+  // Still working: nothing to match yet, and a valid update is taken.
+  EXPECT_FALSE(session.Match(out));
+  g.robot = 2;
+  g.version = 6;
+  g.walls[1].version = 6;
+  EXPECT_TRUE(session.Receive(CollabMessageType::kDistilledGraph, EncodedGraph(g, 5), out));
+  EXPECT_EQ(session.peer_graph(2)->version, 6u);
+  EXPECT_FALSE(session.merged(2));
+  EXPECT_GT(session.stats().store_bytes, 0u);
+}
+
+TEST(RoomMessages, CloudRequestRoundTripAndRejections) {
+  std::vector<std::uint8_t> bytes(kRoomCloudRequestBytes);
+  ASSERT_TRUE(EncodeRoomCloudRequest({2, 5, 17, 9}, bytes));
+  auto q = DecodeRoomCloudRequest(bytes);
+  ASSERT_TRUE(q);
+  EXPECT_EQ(q->from, 2);
+  EXPECT_EQ(q->to, 5);
+  EXPECT_EQ(q->room, 17u);
+  EXPECT_EQ(q->version, 9u);
+  auto bad = bytes;
+  bad[10] ^= 1;
+  EXPECT_EQ(DecodeRoomCloudRequest(bad).error().code, Errc::kChecksum);
+  EXPECT_FALSE(DecodeRoomCloudRequest(std::span(bytes).first(10)));
+  ASSERT_TRUE(EncodeRoomCloudRequest({2, 2, 17, 9}, bytes));  // to itself
+  EXPECT_FALSE(DecodeRoomCloudRequest(bytes));
+}
 }  // namespace msgraphs::core

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -157,6 +158,82 @@ TEST(SGraph, WallsRemoveOdometryDriftAndTheOriginStays) {
     EXPECT_NEAR(p.d, walls[w].d, 0.02);
     EXPECT_EQ(p.observations, walk.truth.size());
   }
+}
+
+// Marginal wall covariances include the keyframes' uncertainty: never smaller than the plane's
+// own (conditional) information says, and larger for walls seen only from far along the walk.
+// A prior from outside (another robot's measurement) pulls a wall, and is removed again.
+TEST(SGraph, PlaneMarginalsAndExternalPriors) {
+  const Room room;
+  const Walk walk(room, 24);
+  const auto walls = room.walls();
+  SGraph g;
+  ASSERT_TRUE(g.Init({}));
+  std::mt19937 rng(5);
+  std::vector<std::uint32_t> ids, plane_ids;
+  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
+    const Eigen::Isometry3d guess =
+        i == 0 ? walk.truth[0]
+               : g.keyframe_pose(ids.back()) * (walk.odometry[i - 1].inverse() * walk.odometry[i]);
+    auto id = g.AddKeyframe(static_cast<double>(i), guess);
+    ASSERT_TRUE(id);
+    if (i > 0) {
+      ASSERT_TRUE(g.AddRelativePose(ids.back(), *id,
+                                    walk.odometry[i - 1].inverse() * walk.odometry[i],
+                                    OdometryInformation(), RelativePoseKind::kOdometry));
+    }
+    ids.push_back(*id);
+    if (i == 0) {
+      for (const TruePlane& w : walls)
+        plane_ids.push_back(*g.AddPlane(w.n, w.d, PlaneClass::kWall));
+    }
+    for (std::size_t w = 0; w < walls.size(); ++w)
+      ASSERT_TRUE(
+          g.AddPlaneObservation(*id, plane_ids[w], Measure(walls[w], walk.truth[i], rng, 0.005)));
+    ASSERT_TRUE(g.Solve(SolveKind::kLocal));  // leaves the older nodes constant
+  }
+  std::vector<Eigen::Matrix3d> marginals(plane_ids.size());
+  ASSERT_TRUE(g.PlaneMarginals(plane_ids, marginals));
+  for (std::size_t w = 0; w < plane_ids.size(); ++w) {
+    const Eigen::Matrix3d conditional = g.plane(plane_ids[w]).information.inverse();
+    // marginal - conditional is positive semi-definite (up to the linearisation point).
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(marginals[w] - conditional);
+    EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-3 * conditional.norm()) << "wall " << w;
+    EXPECT_GT(marginals[w](2, 2), conditional(2, 2)) << "wall " << w;
+    EXPECT_TRUE(marginals[w].allFinite());
+  }
+  std::vector<Eigen::Matrix3d> too_short(1);
+  EXPECT_FALSE(g.PlaneMarginals(plane_ids, too_short));
+  const std::uint32_t missing[] = {999};
+  EXPECT_FALSE(g.PlaneMarginals(missing, marginals));
+
+  // A confident prior 5 cm off pulls the wall most of the way; removed, the wall returns.
+  ASSERT_TRUE(g.Solve(SolveKind::kFull));
+  const MapPlane before = g.plane(plane_ids[0]);
+  PlanePrior prior;
+  prior.plane = plane_ids[0];
+  prior.normal = before.normal;
+  prior.d = before.d + 0.05;
+  prior.covariance = Eigen::Vector3d(1e-6, 1e-6, 1e-6).asDiagonal();
+  auto factor = g.AddPlanePrior(prior);
+  ASSERT_TRUE(factor);
+  ASSERT_TRUE(g.Solve(SolveKind::kFull));
+  EXPECT_GT(g.plane(plane_ids[0]).d - before.d, 0.03);
+  EXPECT_EQ(g.stats().plane_prior_factors, 1u);
+  ASSERT_TRUE(g.RemoveFactor(*factor));
+  ASSERT_TRUE(g.Solve(SolveKind::kFull));
+  EXPECT_NEAR(g.plane(plane_ids[0]).d, before.d, 2e-3);
+  EXPECT_EQ(g.stats().plane_prior_factors, 0u);
+  // Refused: a prior facing the other way, a non-definite covariance, a missing plane.
+  PlanePrior flipped = prior;
+  flipped.normal = -prior.normal;
+  EXPECT_FALSE(g.AddPlanePrior(flipped));
+  PlanePrior singular = prior;
+  singular.covariance.setZero();
+  EXPECT_FALSE(g.AddPlanePrior(singular));
+  PlanePrior nowhere = prior;
+  nowhere.plane = 999;
+  EXPECT_FALSE(g.AddPlanePrior(nowhere));
 }
 
 // Builds a graph of one keyframe seeing the four walls of `room`.

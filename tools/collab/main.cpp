@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // msgraphs_collab: a multi-robot mission (simulator recordings) through the whole Multi S-Graphs
 // pipeline in one process, deterministically: every robot's local S-Graph in lock-step by
-// mission time; every `--exchange-every-s` each robot distils its graph and sends what changed
-// (the real wire encoding, decoded by every peer), plus descriptors of new or changed rooms;
-// receivers match rooms by Scan Context, request room clouds for fine alignment (modes with
-// "fine"), keep the largest mutually consistent set of matches per robot pair, and solve their
-// collaborative graph for the other robots' origins.
+// mission time; every `--exchange-every-s` each robot's core::CollabSession (the same class the
+// onboard node runs) publishes what changed, and the messages cross an in-process radio (the
+// real wire encodings, decoded by every peer, bytes counted per type and link). Receivers match
+// rooms by Scan Context, request room clouds for fine alignment (modes with "fine"), keep the
+// largest mutually consistent set of matches per robot pair, and solve their collaborative graph.
 //
 // At the end it reports, from robot 1's point of view: which robots were merged, the ATE of the
 // aggregated trajectory (every merged robot's keyframes in robot 1's frame through the
@@ -14,10 +14,16 @@
 // message type. --mode keyframes runs the keyframe-level baseline instead of rooms.
 //
 //   msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes]
-//                   [--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]
+//                   [--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off]
+//                   [--exchange-every-s 10] [--out DIR] [--markdown]
 //
-// --out DIR writes robotN_in_robot1.tum: every merged robot's keyframes in robot 1's frame.
+// --feedback on (the default) gives each robot's local S-Graph the other robots' measurements of
+// its matched walls, through the merged origins (CollabSession::PlanePriors).
+//
+// --out DIR writes robotN_in_robot1.tum (every merged robot's keyframes in robot 1's frame) and
+// bytes.csv (cumulative bytes per message type after each exchange, all links together).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -30,8 +36,8 @@
 #include <string>
 #include <vector>
 
+#include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/collab/distilled_codec.hpp"
-#include "msgraphs/core/collab/distiller.hpp"
 #include "msgraphs/core/collab/room_descriptor.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
@@ -47,15 +53,6 @@ namespace {
 using namespace msgraphs;
 namespace fs = std::filesystem;
 
-// kKeyframes is the baseline: keyframe-level inter-robot loop closure as DiSCo-SLAM and
-// Swarm-SLAM exchange it (a Scan Context and the pose of every keyframe; the keyframe cloud on
-// request for verification), through the same fine alignment and consistency check.
-enum class Mode { kRooms, kRoomsFine, kRoomsWalls, kRoomsWallsFine, kKeyframes };
-bool Fine(Mode m) {
-  return m == Mode::kRoomsFine || m == Mode::kRoomsWallsFine || m == Mode::kKeyframes;
-}
-bool Walls(Mode m) { return m == Mode::kRoomsWalls || m == Mode::kRoomsWallsFine; }
-
 enum MessageType {
   kGraph,
   kDescriptor,
@@ -70,31 +67,10 @@ const char* kTypeNames[kMessageTypes] = {"distilled graph",      "room descripto
                                          "keyframe descriptors", "keyframe clouds"};
 constexpr std::size_t kKeyframePoseBytes = 28;  // a keyframe's pose beside its descriptor (7 x f32)
 constexpr float kKeyframeScThreshold = 0.25f;   // keyframe candidates (tighter: many more of them)
-constexpr std::size_t kCloudRequestBytes = 16;  // robot, room, version, CRC
-
-struct RoomDescriptorEntry {
-  std::uint32_t version = 0;  // the room's version when the descriptor was built
-  core::DistilledRoom room;
-  core::DistilledRoom room_at_build;
-  core::ScanContext descriptor;
-};
-
-// A room's descriptor is rebuilt and sent again only when the room changed significantly: other
-// walls, or its centre or size moved by more than this (its graph entry follows every 1 cm).
-constexpr double kDescriptorResendM = 0.3;
-// Once a robot pair holds this many consistent matches, a new candidate is checked against the
-// merged estimate instead of by fine alignment: no room cloud needs to cross the radio.
-constexpr std::size_t kAnchoredMatches = 3;
-
-bool SignificantlyChanged(const core::DistilledRoom& a, const core::DistilledRoom& b) {
-  return a.walls != b.walls || a.shape != b.shape ||
-         (a.centre - b.centre).norm() > kDescriptorResendM ||
-         std::fabs(a.size_x_m - b.size_x_m) > kDescriptorResendM ||
-         std::fabs(a.size_y_m - b.size_y_m) > kDescriptorResendM;
-}
 
 struct Robot {
   int index = 0;  // 0-based; robot ids on the wire are index + 1
+  std::uint16_t id() const { return static_cast<std::uint16_t>(index + 1); }
   std::unique_ptr<tools::RecordedScans> scans;
   std::optional<drivers::can_odometry::CandumpFileReader> candump;
   drivers::can_odometry::OdometryStream odometry =
@@ -103,29 +79,18 @@ struct Robot {
   const drivers::velodyne::Scan* pending = nullptr;
   double first_stamp = -1;
   core::LocalMapper mapper;
-  core::Distiller distiller;
-  core::RoomDescriptorBuilder descriptor_builder;
-  std::uint32_t sent_version = 0;  // reliable delivery: everyone has what was sent
-  // Own room clouds and descriptors, by room id (rebuilt when the room's version changes).
-  std::map<std::uint32_t, std::vector<Eigen::Vector3f>> room_clouds;
-  std::map<std::uint32_t, RoomDescriptorEntry> own_descriptors;
-  // What this robot received from each peer.
-  std::map<int, core::DistilledGraph> peer_graphs;
-  std::map<std::pair<int, std::uint32_t>, RoomDescriptorEntry> peer_descriptors;
-  std::set<std::tuple<int, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> tried;
-  std::map<std::tuple<int, std::uint32_t, std::uint32_t>, std::vector<Eigen::Vector3f>>
-      peer_clouds;                                      // cache
-  std::map<int, std::vector<core::RoomMatch>> matches;  // per peer: accepted by the fine check
-  std::uint64_t rejected_anchored = 0, accepted_anchored = 0;
-  std::map<int, std::vector<std::uint32_t>> consistent;  // per peer: indices into matches
-  core::CollaborativeGraph collab;
-  // Baseline: keyframe descriptors (own), and those received with the sender's pose at the time.
+  core::CollabSession session;
+  // Baseline: keyframe descriptors (own), and those received with the sender's pose at the time;
+  // its matches, consistent sets and collaborative graph (origin measurements only).
   std::uint32_t keyframes_sent = 0;
   std::map<std::uint32_t, core::ScanContext> own_keyframes;
   std::map<std::pair<int, std::uint32_t>, std::pair<core::ScanContext, Eigen::Isometry3d>>
       peer_keyframes;
   std::set<std::pair<int, std::uint32_t>> tried_keyframes;
-  std::uint64_t rejected_fine = 0, rejected_consistency = 0;
+  std::map<int, std::vector<core::RoomMatch>> matches;
+  std::map<int, std::vector<std::uint32_t>> consistent;
+  core::CollaborativeGraph collab;
+  std::uint64_t proposals = 0, rejected_fine = 0, rejected_consistency = 0;
   std::vector<tools::StampedPose> truth;
 };
 
@@ -191,89 +156,81 @@ struct Accounting {
   }
 };
 
+// The radio, in process: messages wait in order until Deliver hands them to their addressees
+// (every peer for a broadcast), counting bytes per type and link. Queued rather than delivered
+// at once so that no session is re-entered while it sends.
+struct Radio final : core::CollabOutbox {
+  struct Message {
+    core::CollabMessageType type;
+    int from;
+    std::uint16_t to;
+    std::vector<std::uint8_t> bytes;
+  };
+  std::vector<Message> queue;
+  int sender = 0;
+  void Send(core::CollabMessageType type,
+            std::uint16_t to,
+            std::span<const std::uint8_t> bytes) override {
+    queue.push_back({type, sender, to, {bytes.begin(), bytes.end()}});
+  }
+};
+
 struct Mission {
   std::vector<std::unique_ptr<Robot>> robots;
-  Mode mode = Mode::kRoomsWallsFine;
+  bool keyframes = false;  // the baseline instead of the room-based algorithm
+  bool feedback = true;    // other robots' walls back into each local S-Graph
+  std::vector<core::PlanePrior> priors = std::vector<core::PlanePrior>(512);
   core::CloudEncoding cloud_encoding = core::CloudEncoding::kQuantised16;
-  core::RoomMatcher matcher;
+  core::RoomMatcher matcher;  // the baseline's
   Accounting accounting;
+  Radio radio;
   std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(8 << 20);
-  BoundedVector<Eigen::Vector3f> decoded_cloud{200000}, cloud_scratch{200000};
-  core::DistilledGraph delta = [] {  // a received message, decoded before it is merged
-    core::DistilledGraph g;
-    g.Init(4096, 512);
-    return g;
-  }();
+  BoundedVector<Eigen::Vector3f> decoded_cloud{200000};
 
-  // Robot `from` distils and sends what changed; descriptors of new or changed rooms.
-  void Exchange(Robot& from) {
-    if (mode == Mode::kKeyframes) {
-      ExchangeKeyframes(from);
+  void Deliver() {
+    for (std::size_t i = 0; i < radio.queue.size(); ++i) {  // Receive may queue answers
+      const Radio::Message m = radio.queue[i];
+      for (auto& to : robots) {
+        if (to->index == m.from || (m.to != 0 && m.to != to->id())) continue;
+        accounting.Add(static_cast<MessageType>(m.type), m.from, to->index, m.bytes.size());
+        radio.sender = to->index;
+        auto s = to->session.Receive(m.type, m.bytes, radio);
+        if (!s && (s.error().code == Errc::kMalformed || s.error().code == Errc::kChecksum)) {
+          if (++accounting.malformed <= 3)
+            std::fprintf(stderr, "collab: robot %d rejected a message: %s\n", to->id(),
+                         s.error().detail);
+        }
+      }
+    }
+    radio.queue.clear();
+  }
+
+  void Exchange() {
+    if (keyframes) {
+      for (auto& r : robots) ExchangeKeyframes(*r);
+      for (auto& r : robots) MatchKeyframes(*r);
       return;
     }
-    from.distiller.Update(from.mapper.graph(), from.mapper.plane_mapper());
-    const core::DistilledGraph& g = from.distiller.graph();
-    if (g.version > from.sent_version) {
-      auto n = core::EncodeDistilled(g, from.sent_version, buffer);
-      if (n) {
-        for (auto& to : robots) {
-          if (to.get() == &from) continue;
-          accounting.Add(kGraph, from.index, to->index, *n);
-          core::DistilledGraph& copy = PeerCopy(*to, from.index);
-          if (!core::DecodeDistilled(std::span(buffer.data(), *n), delta, &copy) ||
-              !core::ApplyDistilled(delta, copy)) {
-            ++accounting.malformed;
-          }
-        }
-        from.sent_version = g.version;
-      }
+    for (auto& r : robots) {
+      radio.sender = r->index;
+      static_cast<void>(r->session.Publish(r->mapper, radio));
     }
-    for (const core::DistilledRoom& room : g.rooms) {
-      auto it = from.own_descriptors.find(room.id);
-      if (it != from.own_descriptors.end()) {
-        it->second.room = room;  // keep the latest estimate for the frames
-        if (!SignificantlyChanged(it->second.room_at_build, room)) continue;
+    Deliver();
+    // Match, deliver the cloud requests and their answers, and align what arrived.
+    for (int round = 0; round < 2; ++round) {
+      for (auto& r : robots) {
+        radio.sender = r->index;
+        r->session.Match(radio);
       }
-      // New or changed: rebuild the room cloud and descriptor, and send the descriptor.
-      RoomDescriptorEntry entry;
-      entry.version = room.version;
-      entry.room = room;
-      entry.room_at_build = room;
-      if (!from.descriptor_builder.Build(from.mapper, room, cloud_scratch, entry.descriptor))
-        continue;
-      from.room_clouds[room.id].assign(cloud_scratch.begin(), cloud_scratch.end());
-      from.own_descriptors[room.id] = entry;
-      const core::RoomDescriptorHeader header{static_cast<std::uint16_t>(from.index + 1), room.id,
-                                              room.version};
-      auto n = core::EncodeRoomDescriptor(header, entry.descriptor, buffer);
-      if (!n) continue;
-      for (auto& to : robots) {
-        if (to.get() == &from) continue;
-        accounting.Add(kDescriptor, from.index, to->index, *n);
-        RoomDescriptorEntry received;
-        auto h = core::DecodeRoomDescriptor(std::span(buffer.data(), *n), received.descriptor);
-        if (!h) {
-          ++accounting.malformed;
-          continue;
-        }
-        received.version = h->version;
-        received.room = room;  // the room itself came with the distilled graph
-        received.room_at_build = room;
-        to->peer_descriptors[{from.index, h->room}] = received;
-      }
+      Deliver();
+    }
+    if (!feedback) return;
+    for (auto& r : robots) {
+      const std::size_t n = r->session.PlanePriors(priors);
+      static_cast<void>(r->mapper.SetPlanePriors(std::span(priors.data(), n)));
     }
   }
 
-  core::DistilledGraph& PeerCopy(Robot& at, int peer) {
-    auto it = at.peer_graphs.find(peer);
-    if (it == at.peer_graphs.end()) {
-      it = at.peer_graphs.emplace(peer, core::DistilledGraph{}).first;
-      it->second.Init(4096, 512);
-    }
-    return it->second;
-  }
-
-  // Robot `a` looks for matches between its rooms and the rooms it received.
   void ExchangeKeyframes(Robot& from) {
     const core::SGraph& g = from.mapper.graph();
     const core::ScanContextConfig sc_config{20, 60, 20.0f, 0.5f};  // heights above the floor
@@ -282,8 +239,7 @@ struct Mission {
       if (cloud.empty()) continue;
       core::ScanContext& sc = from.own_keyframes[k];
       if (!sc.Build(cloud, sc_config)) continue;
-      auto n = core::EncodeRoomDescriptor({static_cast<std::uint16_t>(from.index + 1), k, 0}, sc,
-                                          buffer);
+      auto n = core::EncodeRoomDescriptor({from.id(), k, 0}, sc, buffer);
       if (!n) continue;
       for (auto& to : robots) {
         if (to.get() == &from) continue;
@@ -315,11 +271,11 @@ struct Mission {
         }
       }
       if (best > kKeyframeScThreshold) continue;
+      ++a.proposals;
       Robot& b = *robots[static_cast<std::size_t>(key.first)];
-      accounting.Add(kCloudRequest, a.index, b.index, kCloudRequestBytes);
+      accounting.Add(kCloudRequest, a.index, b.index, core::kRoomCloudRequestBytes);
       const auto cloud_b = b.mapper.keyframe_cloud(key.second);
-      core::RoomCloudHeader header{static_cast<std::uint16_t>(b.index + 1), key.second, 0,
-                                   cloud_encoding, 0.01f};
+      core::RoomCloudHeader header{b.id(), key.second, 0, cloud_encoding, 0.01f};
       auto n = core::EncodeRoomCloud(header, cloud_b, buffer);
       if (!n) continue;
       accounting.Add(kKeyframeCloud, b.index, a.index, *n);
@@ -328,8 +284,8 @@ struct Mission {
         continue;
       }
       core::RoomMatch m;
-      m.robot_a = static_cast<std::uint16_t>(a.index + 1);
-      m.robot_b = static_cast<std::uint16_t>(b.index + 1);
+      m.robot_a = a.id();
+      m.robot_b = b.id();
       m.room_a = best_k;
       m.room_b = key.second;
       m.sc_distance = best;
@@ -342,100 +298,9 @@ struct Mission {
       a.matches[key.first].push_back(m);
       changed = true;
     }
-    if (changed) Solve(a);
-  }
-
-  void Match(Robot& a) {
-    if (mode == Mode::kKeyframes) {
-      MatchKeyframes(a);
-      return;
-    }
-    bool changed = false;
-    for (const auto& [key, theirs] : a.peer_descriptors) {
-      const int b_index = key.first;
-      Robot& b = *robots[static_cast<std::size_t>(b_index)];
-      for (const auto& [room_a_id, mine] : a.own_descriptors) {
-        const auto tried_key =
-            std::make_tuple(b_index, room_a_id, mine.version, key.second, theirs.version);
-        if (a.tried.count(tried_key) != 0) continue;
-        a.tried.insert(tried_key);
-        const auto sc = core::ScanContextDistance(mine.descriptor, theirs.descriptor, true);
-        if (!sc || sc->distance > matcher.config().sc_threshold) continue;
-        if (mine.room.shape != theirs.room.shape) continue;
-        core::RoomMatch m;
-        m.robot_a = static_cast<std::uint16_t>(a.index + 1);
-        m.robot_b = static_cast<std::uint16_t>(b.index + 1);
-        m.room_a = room_a_id;
-        m.room_b = key.second;
-        m.sc_distance = sc->distance;
-        const double floor_a = -a.mapper.config().base_height_m,
-                     floor_b = -b.mapper.config().base_height_m;
-        const Eigen::Isometry3d T_ma_ra = core::RoomFrame(mine.room, floor_a);
-        const Eigen::Isometry3d T_mb_rb = core::RoomFrame(theirs.room, floor_b);
-        const auto robot_b = static_cast<std::uint16_t>(b.index + 1);
-        const auto consistent = a.consistent.find(b_index);
-        if (consistent != a.consistent.end() && consistent->second.size() >= kAnchoredMatches &&
-            a.collab.has_robot(robot_b)) {
-          // Anchored pair: the candidate must agree with the merged estimate (up to the room's
-          // quarter turns), or it is an identical room elsewhere.
-          const Eigen::Isometry3d estimate = a.collab.T_self_robot(robot_b);
-          bool agrees = false;
-          for (int q = 0; q < 4 && !agrees; ++q) {
-            const Eigen::Isometry3d T = core::MatchFromRoomFrames(
-                T_ma_ra, T_mb_rb, static_cast<double>(sc->yaw_rad) + q * 1.5707963267948966);
-            const Eigen::Isometry3d e = estimate.inverse() * T;
-            if (e.translation().head<2>().norm() < 0.5 &&
-                Eigen::AngleAxisd(e.linear()).angle() < 0.1) {
-              m.T_a_b = T;
-              agrees = true;
-            }
-          }
-          if (!agrees) {
-            ++a.rejected_anchored;
-            continue;
-          }
-          ++a.accepted_anchored;
-        } else if (Fine(mode)) {
-          // Request b's room cloud (once per version of it); b answers with it.
-          const auto cache_key = std::make_tuple(b_index, key.second, theirs.version);
-          auto cached = a.peer_clouds.find(cache_key);
-          if (cached == a.peer_clouds.end()) {
-            accounting.Add(kCloudRequest, a.index, b.index, kCloudRequestBytes);
-            const auto& cloud_b = b.room_clouds[key.second];
-            core::RoomCloudHeader header{robot_b, key.second, theirs.version, cloud_encoding,
-                                         0.01f};
-            auto n = core::EncodeRoomCloud(header, cloud_b, buffer);
-            if (!n) continue;
-            accounting.Add(kCloud, b.index, a.index, *n);
-            if (!core::DecodeRoomCloud(std::span(buffer.data(), *n), decoded_cloud)) {
-              ++accounting.malformed;
-              continue;
-            }
-            cached = a.peer_clouds
-                         .emplace(cache_key, std::vector<Eigen::Vector3f>(decoded_cloud.begin(),
-                                                                          decoded_cloud.end()))
-                         .first;
-          }
-          const auto& cloud_a = a.room_clouds[room_a_id];
-          if (!matcher.FineAlign(cloud_a, T_ma_ra, cached->second, T_mb_rb,
-                                 static_cast<double>(sc->yaw_rad), m)) {
-            ++a.rejected_fine;
-            continue;
-          }
-        } else {
-          m.T_a_b = core::MatchFromRoomFrames(T_ma_ra, T_mb_rb, static_cast<double>(sc->yaw_rad));
-        }
-        a.matches[b_index].push_back(m);
-        changed = true;
-      }
-    }
-    if (changed) Solve(a);
-  }
-
-  void Solve(Robot& a) {
+    if (!changed) return;
     a.collab.Clear();
     a.rejected_consistency = 0;
-    const core::DistilledGraph& mine = a.distiller.graph();
     for (auto& [b_index, list] : a.matches) {
       std::vector<std::uint32_t> keep(std::min<std::size_t>(list.size(), 64));
       keep.resize(core::ConsistentMatches(list, matcher.config(), keep));
@@ -444,40 +309,30 @@ struct Mission {
       if (keep.empty()) continue;
       const auto robot_b = static_cast<std::uint16_t>(b_index + 1);
       static_cast<void>(a.collab.SetInitial(robot_b, list[keep[0]].T_a_b));
-      const core::DistilledGraph& theirs = PeerCopy(a, b_index);
-      for (std::uint32_t i : keep) {
-        const core::RoomMatch& m = list[i];
-        // A fine alignment measured the origin directly, from the clouds themselves.
-        if (m.fine_aligned)
-          static_cast<void>(a.collab.AddOriginMeasurement(robot_b, m.T_a_b, 0.03, 0.005));
-        if (mode == Mode::kKeyframes) continue;  // the baseline has no rooms or walls
-        const core::DistilledRoom* ra = nullptr;
-        const core::DistilledRoom* rb = nullptr;
-        for (const auto& r : mine.rooms) ra = r.id == m.room_a ? &r : ra;
-        for (const auto& r : theirs.rooms) rb = r.id == m.room_b ? &r : rb;
-        if (ra == nullptr || rb == nullptr) continue;
-        static_cast<void>(
-            a.collab.AddRoomRoom(robot_b, ra->centre, ra->yaw_rad, rb->centre, rb->yaw_rad));
-        if (!Walls(mode)) continue;
-        // Pair the two rooms' walls through the match: same facing and offset after T_a_b.
-        for (std::int32_t wa : ra->walls) {
-          const core::DistilledWall* A =
-              wa < 0 ? nullptr : mine.FindWall(static_cast<std::uint32_t>(wa));
-          if (A == nullptr) continue;
-          for (std::int32_t wb : rb->walls) {
-            const core::DistilledWall* B =
-                wb < 0 ? nullptr : theirs.FindWall(static_cast<std::uint32_t>(wb));
-            if (B == nullptr) continue;
-            const Eigen::Vector3d n = m.T_a_b.linear() * B->normal;
-            const double d = B->d - n.dot(m.T_a_b.translation());
-            if (n.dot(A->normal) > std::cos(0.26) && std::fabs(d - A->d) < 0.3) {
-              static_cast<void>(a.collab.AddWallWall(robot_b, *A, *B));
-            }
-          }
-        }
-      }
+      for (std::uint32_t i : keep)
+        static_cast<void>(a.collab.AddOriginMeasurement(robot_b, list[i].T_a_b, 0.03, 0.005));
     }
     static_cast<void>(a.collab.Solve());
+  }
+
+  // The view of robot a: merged robots, their origins, accepted matches.
+  bool Merged(const Robot& a, int b_index) const {
+    const auto robot = static_cast<std::uint16_t>(b_index + 1);
+    return keyframes ? a.collab.has_robot(robot) : a.session.merged(robot);
+  }
+  Eigen::Isometry3d Origin(const Robot& a, int b_index) const {
+    const auto robot = static_cast<std::uint16_t>(b_index + 1);
+    return keyframes ? a.collab.T_self_robot(robot) : a.session.T_self_robot(robot);
+  }
+  std::vector<core::RoomMatch> Accepted(Robot& a, int b_index) {
+    std::vector<core::RoomMatch> out;
+    if (keyframes) {
+      for (std::uint32_t i : a.consistent[b_index]) out.push_back(a.matches[b_index][i]);
+    } else {
+      out.resize(64);
+      out.resize(a.session.ConsistentMatches(static_cast<std::uint16_t>(b_index + 1), out));
+    }
+    return out;
   }
 };
 
@@ -486,8 +341,10 @@ struct Mission {
 int main(int argc, char** argv) {
   std::string run, out_dir;
   Mission mission;
+  core::CollabSessionConfig session_config;
+  std::string mode_name = "rooms-walls-fine";
   double every_s = 10.0;
-  bool markdown = false;
+  bool markdown = false, step_given = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--run" && i + 1 < argc)
@@ -499,30 +356,49 @@ int main(int argc, char** argv) {
     else if (a == "--out" && i + 1 < argc)
       out_dir = argv[++i];
     else if (a == "--mode" && i + 1 < argc) {
-      const std::string m = argv[++i];
-      if (m == "rooms")
-        mission.mode = Mode::kRooms;
-      else if (m == "rooms-fine")
-        mission.mode = Mode::kRoomsFine;
-      else if (m == "rooms-walls")
-        mission.mode = Mode::kRoomsWalls;
-      else if (m == "rooms-walls-fine")
-        mission.mode = Mode::kRoomsWallsFine;
-      else if (m == "keyframes")
-        mission.mode = Mode::kKeyframes;
+      mode_name = argv[++i];
+      if (mode_name == "rooms")
+        session_config.mode = {false, false};
+      else if (mode_name == "rooms-fine")
+        session_config.mode = {false, true};
+      else if (mode_name == "rooms-walls")
+        session_config.mode = {true, false};
+      else if (mode_name == "rooms-walls-fine")
+        session_config.mode = {true, true};
+      else if (mode_name == "keyframes")
+        mission.keyframes = true;
       else {
-        std::fprintf(stderr, "collab: unknown mode %s\n", m.c_str());
+        std::fprintf(stderr, "collab: unknown mode %s\n", mode_name.c_str());
         return 2;
       }
     } else if (a == "--cloud" && i + 1 < argc) {
       const std::string c = argv[++i];
-      mission.cloud_encoding =
-          c == "f32" ? core::CloudEncoding::kFloat32 : core::CloudEncoding::kQuantised16;
+      if (c != "f32" && c != "q16" && c != "q8") {
+        std::fprintf(stderr, "collab: --cloud is f32, q16 or q8\n");
+        return 2;
+      }
+      mission.cloud_encoding = c == "f32"   ? core::CloudEncoding::kFloat32
+                               : c == "q16" ? core::CloudEncoding::kQuantised16
+                                            : core::CloudEncoding::kQuantised8;
+      if (c == "q8" && !step_given) session_config.cloud_step_m = 0.05f;
+    } else if (a == "--feedback" && i + 1 < argc) {
+      const std::string f = argv[++i];
+      if (f != "on" && f != "off") {
+        std::fprintf(stderr, "collab: --feedback is on or off\n");
+        return 2;
+      }
+      mission.feedback = f == "on";
+    } else if (a == "--cloud-step" && i + 1 < argc) {
+      session_config.cloud_step_m = static_cast<float>(std::atof(argv[++i]));
+      step_given = true;
     } else {
-      std::fprintf(stderr,
-                   "usage: msgraphs_collab --run DIR [--mode "
-                   "rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes] "
-                   "[--cloud f32|q16] [--exchange-every-s 10] [--out DIR] [--markdown]\n");
+      std::fprintf(
+          stderr,
+          "usage: msgraphs_collab --run DIR [--mode "
+          "rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes] "
+          "[--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off] [--exchange-every-s 10] "
+          "[--out DIR] "
+          "[--markdown]\n");
       return 2;
     }
   }
@@ -530,7 +406,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "collab: --run DIR is required\n");
     return 2;
   }
-  if (!mission.matcher.Init({})) return 1;
+  session_config.cloud_encoding = mission.cloud_encoding;
+  if (auto s = mission.matcher.Init({}); !s) {
+    std::fprintf(stderr, "collab: %s\n", s.error().detail);
+    return 1;
+  }
   for (int i = 0; i < 10; ++i) {
     const fs::path dir = fs::path(run) / ("robot" + std::to_string(i + 1));
     if (!fs::exists(dir / "velodyne.pcap")) break;
@@ -544,9 +424,12 @@ int main(int argc, char** argv) {
     }
     r->candump.emplace(std::move(*candump));
     core::LocalMapperConfig config;
-    if (!r->mapper.Init(config) ||
-        !r->distiller.Init(static_cast<std::uint16_t>(i + 1), config.graph, {}) ||
-        !r->descriptor_builder.Init({}) || !r->collab.Init({})) {
+    session_config.robot = r->id();
+    Status s = r->mapper.Init(config);
+    if (s) s = r->session.Init(session_config, config.graph, -config.base_height_m);
+    if (s) s = r->collab.Init({}, r->id());
+    if (!s) {
+      std::fprintf(stderr, "collab: %s\n", s.error().detail);
       return 1;
     }
     r->truth = tools::ReadTum((dir / "ground_truth.tum").string());
@@ -559,6 +442,8 @@ int main(int argc, char** argv) {
   }
   const auto t0 = std::chrono::steady_clock::now();
   double next_exchange = every_s;
+  // Cumulative bytes per message type after each exchange, for --out DIR/bytes.csv.
+  std::vector<std::pair<double, std::array<std::uint64_t, kMessageTypes>>> timeline;
   for (;;) {
     Robot* next = nullptr;
     for (auto& r : mission.robots) {
@@ -567,15 +452,20 @@ int main(int argc, char** argv) {
     if (next == nullptr) break;
     const double t = Now(*next);
     if (t >= next_exchange) {
-      for (auto& r : mission.robots) mission.Exchange(*r);
-      for (auto& r : mission.robots) mission.Match(*r);
+      mission.Exchange();
+      timeline.push_back({t, {}});
+      for (int k = 0; k < kMessageTypes; ++k)
+        timeline.back().second[static_cast<std::size_t>(k)] = mission.accounting.Total(k);
       next_exchange += every_s;
     }
     ProcessScan(*next);
   }
   for (auto& r : mission.robots) static_cast<void>(r->mapper.Finish());
-  for (auto& r : mission.robots) mission.Exchange(*r);
-  for (auto& r : mission.robots) mission.Match(*r);
+  mission.Exchange();
+  // The last exchange's wall priors into the final maps.
+  if (mission.feedback && !mission.keyframes) {
+    for (auto& r : mission.robots) static_cast<void>(r->mapper.Finish());
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -594,13 +484,11 @@ int main(int argc, char** argv) {
     std::sort(kf.begin(), kf.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
     const auto own = tools::ComputeAte(kf, r->truth, 0.006);
     T_world_map[static_cast<std::size_t>(r->index)] = own.T_truth_estimate;
-    const bool in =
-        r->index == 0 || self.collab.has_robot(static_cast<std::uint16_t>(r->index + 1));
+    const bool in = r->index == 0 || mission.Merged(self, r->index);
     if (r->index != 0 && in) ++merged;
     if (!in) continue;
     const Eigen::Isometry3d T_1_b =
-        r->index == 0 ? Eigen::Isometry3d::Identity()
-                      : self.collab.T_self_robot(static_cast<std::uint16_t>(r->index + 1));
+        r->index == 0 ? Eigen::Isometry3d::Identity() : mission.Origin(self, r->index);
     if (!out_dir.empty()) {
       std::vector<tools::StampedPose> in_1;
       for (const auto& p : kf) in_1.push_back({p.t, T_1_b * p.T});
@@ -619,13 +507,27 @@ int main(int argc, char** argv) {
       }
     }
   }
+  if (!out_dir.empty()) {
+    fs::create_directories(out_dir);
+    if (std::FILE* f = std::fopen((fs::path(out_dir) / "bytes.csv").c_str(), "w")) {
+      std::fprintf(f, "mission_time_s");
+      for (int k = 0; k < kMessageTypes; ++k) std::fprintf(f, ",%s", kTypeNames[k]);
+      std::fprintf(f, "\n");
+      for (const auto& [t, bytes] : timeline) {
+        std::fprintf(f, "%.1f", t);
+        for (std::uint64_t b : bytes) std::fprintf(f, ",%llu", static_cast<unsigned long long>(b));
+        std::fprintf(f, "\n");
+      }
+      std::fclose(f);
+    }
+  }
   // Accepted matches (consistent sets) of every robot, checked against the truth.
   for (auto& r : mission.robots) {
-    for (const auto& [b_index, keep] : r->consistent) {
-      for (std::uint32_t i : keep) {
-        const core::RoomMatch& m = r->matches[b_index][i];
+    for (auto& b : mission.robots) {
+      if (b == r) continue;
+      for (const core::RoomMatch& m : mission.Accepted(*r, b->index)) {
         const Eigen::Isometry3d truth = T_world_map[static_cast<std::size_t>(r->index)].inverse() *
-                                        T_world_map[static_cast<std::size_t>(b_index)];
+                                        T_world_map[static_cast<std::size_t>(b->index)];
         const Eigen::Isometry3d e = truth.inverse() * m.T_a_b;
         ++accepted;
         if (e.translation().head<2>().norm() > 0.5 || Eigen::AngleAxisd(e.linear()).angle() > 0.1)
@@ -634,55 +536,57 @@ int main(int argc, char** argv) {
     }
   }
   std::uint64_t proposed = 0, rejected_fine = 0, rejected_consistency = 0, rejected_anchored = 0,
-                accepted_anchored = 0;
+                checked_anchored = 0;
   for (auto& r : mission.robots) {
-    for (const auto& [b, list] : r->matches) proposed += list.size();
-    rejected_fine += r->rejected_fine;
-    rejected_consistency += r->rejected_consistency;
-    rejected_anchored += r->rejected_anchored;
-    accepted_anchored += r->accepted_anchored;
+    if (mission.keyframes) {
+      proposed += r->proposals;
+      rejected_fine += r->rejected_fine;
+      rejected_consistency += r->rejected_consistency;
+      continue;
+    }
+    const core::CollabSessionStats& st = r->session.stats();
+    proposed += st.proposals;
+    rejected_fine += st.rejected_fine;
+    rejected_consistency += st.rejected_consistency;
+    rejected_anchored += st.rejected_anchored;
+    checked_anchored += st.checked_anchored;
   }
   const auto ate = tools::ComputeAte(aggregated, aggregated_truth, 0.5);
-  const char* mode_names[] = {"Rooms", "Rooms + fine alignment", "Rooms and walls",
-                              "Rooms and walls + fine alignment", "Keyframes (baseline)"};
   const double mb = static_cast<double>(mission.accounting.Total()) / 1e6;
   if (markdown) {
     std::printf("| %s | %zu | %s | %zu / %zu | %.3f | %.3f | %llu / %llu | %llu |\n", run.c_str(),
-                mission.robots.size(), mode_names[static_cast<int>(mission.mode)], merged,
-                mission.robots.size(), ate.rmse, mb,
-                static_cast<unsigned long long>(accepted - wrong),
+                mission.robots.size(), mode_name.c_str(), merged, mission.robots.size(), ate.rmse,
+                mb, static_cast<unsigned long long>(accepted - wrong),
                 static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(wrong));
     return 0;
   }
   std::printf("mission %s: %zu robots, mode %s, %.1f s\n", run.c_str(), mission.robots.size(),
-              mode_names[static_cast<int>(mission.mode)], seconds);
+              mode_name.c_str(), seconds);
   std::printf(
       "robot 1 merged %zu of %zu robots; aggregated ATE %.3f m over %zu keyframes (max %.3f m)\n",
       merged, mission.robots.size(), ate.rmse, ate.poses, ate.max);
   for (auto& r : mission.robots) {
     if (r->index == 0) continue;
-    const auto robot = static_cast<std::uint16_t>(r->index + 1);
-    if (!self.collab.has_robot(robot)) {
+    if (!mission.Merged(self, r->index)) {
       std::printf("  robot %d: not merged\n", r->index + 1);
       continue;
     }
     const Eigen::Isometry3d truth =
         T_world_map[0].inverse() * T_world_map[static_cast<std::size_t>(r->index)];
-    const Eigen::Isometry3d e = truth.inverse() * self.collab.T_self_robot(robot);
-    std::printf("  robot %d: origin error %.3f m, %.2f deg (%zu factors)\n", r->index + 1,
-                e.translation().head<2>().norm(),
-                Eigen::AngleAxisd(e.linear()).angle() * 180.0 / 3.14159265358979,
-                self.collab.factors(robot));
+    const Eigen::Isometry3d e = truth.inverse() * mission.Origin(self, r->index);
+    const std::size_t factors = mission.keyframes
+                                    ? self.collab.factors(r->id())
+                                    : self.session.collaborative_graph().factors(r->id());
+    std::printf("  robot %d: origin error %.3f m (z %+.3f m), %.2f deg (%zu factors)\n",
+                r->index + 1, e.translation().head<2>().norm(), e.translation().z(),
+                Eigen::AngleAxisd(e.linear()).angle() * 180.0 / 3.14159265358979, factors);
   }
   std::printf(
       "room matches (all robots): %llu proposed by Scan Context, %llu rejected by fine alignment, "
-      "%llu checked "
-      "against a merged estimate (%llu rejected), %llu rejected by the consistency check, %llu "
-      "accepted, %llu of them "
-      "wrong against the truth\n",
-      static_cast<unsigned long long>(proposed + rejected_fine + rejected_anchored),
-      static_cast<unsigned long long>(rejected_fine),
-      static_cast<unsigned long long>(accepted_anchored + rejected_anchored),
+      "%llu checked against a merged estimate (%llu rejected), %llu rejected by the consistency "
+      "check, %llu accepted, %llu of them wrong against the truth\n",
+      static_cast<unsigned long long>(proposed), static_cast<unsigned long long>(rejected_fine),
+      static_cast<unsigned long long>(checked_anchored),
       static_cast<unsigned long long>(rejected_anchored),
       static_cast<unsigned long long>(rejected_consistency),
       static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(wrong));
@@ -702,6 +606,25 @@ int main(int argc, char** argv) {
       std::printf("  robot %d -> robot %d %10.1f kB\n", from->index + 1, to->index + 1,
                   static_cast<double>(sum) / 1e3);
     }
+  }
+  if (!mission.keyframes) {
+    const core::CollabSessionStats& st = self.session.stats();
+    std::printf(
+        "robot 1 session: %zu own rooms (peak room cloud %zu points), %zu peers, stores %.1f MB; "
+        "refused: rooms %llu, clouds too large %llu, descriptors %llu, pending %llu, matches %llu; "
+        "cache evictions %llu; solves %llu (%llu failed); marginal wall covariances %llu times "
+        "(%llu fell back)\n",
+        st.own_rooms, st.room_points_peak, st.peers, static_cast<double>(st.store_bytes) / 1e6,
+        static_cast<unsigned long long>(st.rooms_refused),
+        static_cast<unsigned long long>(st.room_clouds_too_large),
+        static_cast<unsigned long long>(st.descriptors_refused),
+        static_cast<unsigned long long>(st.pending_refused),
+        static_cast<unsigned long long>(st.matches_refused),
+        static_cast<unsigned long long>(st.cache_evictions),
+        static_cast<unsigned long long>(st.solves),
+        static_cast<unsigned long long>(st.solve_failures),
+        static_cast<unsigned long long>(st.marginal_updates),
+        static_cast<unsigned long long>(st.marginal_failures));
   }
   return 0;
 }

@@ -83,7 +83,7 @@ Error Malformed(const char* why) { return Error{Errc::kMalformed, why}; }
 }  // namespace
 
 std::size_t DistilledEncodedSize(const DistilledGraph& graph, std::uint32_t since) {
-  return kDistilledHeaderBytes + (graph.has_floor ? 8u : 0u) +
+  return kDistilledHeaderBytes + (graph.has_floor ? kDistilledFloorBytes : 0u) +
          CountWalls(graph, since) * kDistilledWallBytes +
          CountRooms(graph, since) * kDistilledRoomBytes + 4u;
 }
@@ -109,6 +109,7 @@ Expected<std::size_t> EncodeDistilled(const DistilledGraph& g,
   if (g.has_floor) {
     w.F32(g.floor_centre.x());
     w.F32(g.floor_centre.y());
+    w.F32(static_cast<float>(g.floor_z_m));
   }
   for (const DistilledWall& x : g.walls) {
     if (x.version <= since) continue;
@@ -165,7 +166,8 @@ Expected<DistilledDelta> DecodeDistilled(std::span<const std::uint8_t> bytes,
   const std::size_t walls = r.U16(), rooms = r.U16();
   if (delta.since >= out.version && (walls > 0 || rooms > 0))
     return Malformed("distilled graph: elements newer than the graph");
-  const std::size_t expected = kDistilledHeaderBytes + ((flags & 1u) != 0 ? 8u : 0u) +
+  const std::size_t expected = kDistilledHeaderBytes +
+                               ((flags & 1u) != 0 ? kDistilledFloorBytes : 0u) +
                                walls * kDistilledWallBytes + rooms * kDistilledRoomBytes;
   if (expected != body)
     return Malformed("distilled graph: length does not match the element counts");
@@ -176,7 +178,9 @@ Expected<DistilledDelta> DecodeDistilled(std::span<const std::uint8_t> bytes,
     out.has_floor = true;
     out.floor_centre.x() = r.F32();
     out.floor_centre.y() = r.F32();
-    if (!out.floor_centre.allFinite()) return Malformed("distilled graph: floor not finite");
+    out.floor_z_m = r.F32();
+    if (!out.floor_centre.allFinite() || !std::isfinite(out.floor_z_m))
+      return Malformed("distilled graph: floor not finite");
   }
   for (std::size_t i = 0; i < walls; ++i) {
     DistilledWall w;
@@ -262,7 +266,10 @@ Status ApplyDistilled(const DistilledGraph& delta, DistilledGraph& copy) {
   copy.robot = delta.robot;
   copy.version = std::max(copy.version, delta.version);
   copy.has_floor = delta.has_floor || copy.has_floor;
-  if (delta.has_floor) copy.floor_centre = delta.floor_centre;
+  if (delta.has_floor) {
+    copy.floor_centre = delta.floor_centre;
+    copy.floor_z_m = delta.floor_z_m;
+  }
   bool full = false;
   for (const DistilledWall& w : delta.walls) full = !Upsert(copy.walls, w) || full;
   for (const DistilledRoom& r : delta.rooms) full = !Upsert(copy.rooms, r) || full;

@@ -24,6 +24,9 @@ Status Distiller::Init(std::uint16_t robot,
   wall_slot_.assign(graph.max_planes, -1);
   room_slot_.assign(graph.max_rooms, -1);
   needed_.assign(graph.max_planes, 0);
+  eligible_.Init(graph.max_planes);
+  marginals_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
+  stats_ = {};
   return Ok();
 }
 
@@ -40,13 +43,33 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
         needed_[static_cast<std::size_t>(w)] = 1;
     }
   }
+  // The walls to share, then their marginal covariances from one factorisation.
+  eligible_.clear();
   for (std::uint32_t id = 0; id < graph.plane_slots() && id < wall_slot_.size(); ++id) {
     const MapPlane p = graph.plane(id);
     if (!p.active || p.plane_class != PlaneClass::kWall) continue;
     if (p.observations < config_.min_wall_observations && needed_[id] == 0) continue;
     Eigen::LLT<Eigen::Matrix3d> llt(p.information);
     if (llt.info() != Eigen::Success) continue;  // not yet constrained in every direction
-    const Eigen::Matrix3d covariance = llt.solve(Eigen::Matrix3d::Identity());
+    eligible_.push_back(id);
+  }
+  bool marginals = false;
+  if (config_.marginal_covariances && !eligible_.empty()) {
+    marginals = static_cast<bool>(graph.PlaneMarginals(eligible_.span(), marginals_));
+    if (marginals)
+      ++stats_.marginal_updates;
+    else
+      ++stats_.marginal_failures;  // the conditional covariances stand in
+  }
+  for (std::size_t i = 0; i < eligible_.size(); ++i) {
+    const std::uint32_t id = eligible_[i];
+    const MapPlane p = graph.plane(id);
+    Eigen::Matrix3d covariance =
+        marginals ? marginals_[i]
+                  : Eigen::Matrix3d(p.information.llt().solve(Eigen::Matrix3d::Identity()));
+    // Symmetric, and definite after the wire's f32 rounding: a 10 um / 10 urad floor.
+    covariance = 0.5 * (covariance + covariance.transpose()).eval();
+    covariance.diagonal().array() += 1e-10;
     const WallExtent& e = planes.extent(id);
     DistilledWall* w = nullptr;
     if (wall_slot_[id] < 0) {
@@ -139,6 +162,7 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
     changed = true;
   }
   out_.has_floor = has_floor;
+  out_.floor_z_m = config_.floor_z_m;
   if (changed) out_.version = next;
   return changed;
 }

@@ -103,16 +103,20 @@ Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t
 }
 
 std::size_t RoomCloudEncodedSize(CloudEncoding encoding, std::size_t points) {
-  return kCloudHeader + points * (encoding == CloudEncoding::kFloat32 ? 12u : 6u) + 4;
+  const std::size_t per_point = encoding == CloudEncoding::kFloat32       ? 12u
+                                : encoding == CloudEncoding::kQuantised16 ? 6u
+                                                                          : 3u;
+  return kCloudHeader + points * per_point + 4;
 }
 
 Expected<std::size_t> EncodeRoomCloud(const RoomCloudHeader& h,
                                       std::span<const Eigen::Vector3f> points,
                                       std::span<std::uint8_t> out) {
-  if (h.encoding != CloudEncoding::kFloat32 && h.encoding != CloudEncoding::kQuantised16) {
+  if (h.encoding != CloudEncoding::kFloat32 && h.encoding != CloudEncoding::kQuantised16 &&
+      h.encoding != CloudEncoding::kQuantised8) {
     return Error{Errc::kInvalidArgument, "room cloud: unknown encoding"};
   }
-  if (h.encoding == CloudEncoding::kQuantised16 && !(h.step_m > 0))
+  if (h.encoding != CloudEncoding::kFloat32 && !(h.step_m > 0))
     return Error{Errc::kInvalidArgument, "room cloud: step must be positive"};
   const std::size_t size = RoomCloudEncodedSize(h.encoding, points.size());
   if (size > out.size())
@@ -132,12 +136,18 @@ Expected<std::size_t> EncodeRoomCloud(const RoomCloudHeader& h,
       if (h.encoding == CloudEncoding::kFloat32) {
         PutF32(p + at, q[k]);
         at += 4;
-      } else {
+      } else if (h.encoding == CloudEncoding::kQuantised16) {
         const float units = std::round(q[k] / h.step_m);
         if (!(std::fabs(units) <= 32767.0f))
           return Error{Errc::kInvalidArgument, "room cloud: point beyond the quantised range"};
         WriteU16Le(p + at, static_cast<std::uint16_t>(static_cast<std::int16_t>(units)));
         at += 2;
+      } else {
+        const float units = std::round(q[k] / h.step_m);
+        if (!(std::fabs(units) <= 127.0f))
+          return Error{Errc::kInvalidArgument, "room cloud: point beyond the quantised range"};
+        p[at] = static_cast<std::uint8_t>(static_cast<std::int8_t>(units));
+        at += 1;
       }
     }
   }
@@ -151,7 +161,7 @@ Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
   if (auto s = CheckCrc(bytes, kCloudHeader); !s) return s.error();
   if (!MagicIs(bytes, "MSRC")) return Error{Errc::kMalformed, "room cloud: bad magic"};
   if (bytes[4] != kFormat) return Error{Errc::kUnsupported, "room cloud: unknown format"};
-  if (bytes[5] > 1) return Error{Errc::kMalformed, "room cloud: unknown encoding"};
+  if (bytes[5] > 2) return Error{Errc::kMalformed, "room cloud: unknown encoding"};
   RoomCloudHeader h;
   h.encoding = static_cast<CloudEncoding>(bytes[5]);
   h.robot = ReadU16Le(&bytes[6]);
@@ -159,7 +169,7 @@ Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
   h.version = ReadU32Le(&bytes[12]);
   h.step_m = GetF32(&bytes[16]);
   const std::size_t count = ReadU32Le(&bytes[20]);
-  if (h.encoding == CloudEncoding::kQuantised16 && !(h.step_m > 0 && std::isfinite(h.step_m))) {
+  if (h.encoding != CloudEncoding::kFloat32 && !(h.step_m > 0 && std::isfinite(h.step_m))) {
     return Error{Errc::kMalformed, "room cloud: bad quantisation step"};
   }
   if (count > points.capacity())
@@ -173,9 +183,12 @@ Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
       if (h.encoding == CloudEncoding::kFloat32) {
         q[k] = GetF32(&bytes[at]);
         at += 4;
-      } else {
+      } else if (h.encoding == CloudEncoding::kQuantised16) {
         q[k] = static_cast<float>(static_cast<std::int16_t>(ReadU16Le(&bytes[at]))) * h.step_m;
         at += 2;
+      } else {
+        q[k] = static_cast<float>(static_cast<std::int8_t>(bytes[at])) * h.step_m;
+        at += 1;
       }
     }
     if (!q.allFinite()) {
@@ -185,6 +198,37 @@ Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
     points.push_back(q);
   }
   return h;
+}
+
+Expected<std::size_t> EncodeRoomCloudRequest(const RoomCloudRequest& q,
+                                             std::span<std::uint8_t> out) {
+  if (out.size() < kRoomCloudRequestBytes)
+    return Error{Errc::kCapacityExceeded, "room cloud request: output buffer too small"};
+  std::uint8_t* p = out.data();
+  std::memcpy(p, "MSRQ", 4);
+  p[4] = kFormat;
+  WriteU16Le(p + 5, q.from);
+  WriteU16Le(p + 7, q.to);
+  WriteU32Le(p + 9, q.room);
+  WriteU32Le(p + 13, q.version);
+  WriteU32Le(p + 17, Crc32(out.first(17)));
+  return kRoomCloudRequestBytes;
+}
+
+Expected<RoomCloudRequest> DecodeRoomCloudRequest(std::span<const std::uint8_t> bytes) {
+  if (auto s = CheckCrc(bytes, kRoomCloudRequestBytes - 4); !s) return s.error();
+  if (bytes.size() != kRoomCloudRequestBytes)
+    return Error{Errc::kMalformed, "room cloud request: wrong length"};
+  if (!MagicIs(bytes, "MSRQ")) return Error{Errc::kMalformed, "room cloud request: bad magic"};
+  if (bytes[4] != kFormat) return Error{Errc::kUnsupported, "room cloud request: unknown format"};
+  RoomCloudRequest q;
+  q.from = ReadU16Le(&bytes[5]);
+  q.to = ReadU16Le(&bytes[7]);
+  q.room = ReadU32Le(&bytes[9]);
+  q.version = ReadU32Le(&bytes[13]);
+  if (q.from == 0 || q.to == 0 || q.from == q.to)
+    return Error{Errc::kMalformed, "room cloud request: robot ids must be distinct and non-zero"};
+  return q;
 }
 
 }  // namespace msgraphs::core

@@ -9,51 +9,106 @@
 namespace msgraphs::core {
 namespace {
 
-// Point b of robot b's map in map a: R(theta) b + t, with origin = [x, y, theta].
+// Origins: Eigen quaternion (x, y, z, w) and translation; p_self = R p_robot + t.
 template <typename T>
-Eigen::Matrix<T, 2, 1> ToA(const T* origin, const Eigen::Vector2d& b) {
-  const T c = cos(origin[2]), s = sin(origin[2]);
-  return {c * T(b.x()) - s * T(b.y()) + origin[0], s * T(b.x()) + c * T(b.y()) + origin[1]};
+Eigen::Matrix<T, 3, 3> Rotation(const T* q) {
+  return Eigen::Quaternion<T>(q[3], q[0], q[1], q[2]).toRotationMatrix();
 }
 
-struct RoomRoomResidual {
-  Eigen::Vector2d centre_a, centre_b;
-  double yaw_a, yaw_b, inv_sigma, inv_sigma_yaw;
+// A wall node (n, d in self's frame) against what its robot measured (n_m, d_m in the robot's
+// frame): the node expressed in the robot's frame, in the measurement's tangent coordinates
+// (u.n, v.n, delta d), whitened by the measurement's square-root information.
+struct WallMeasured {
+  Eigen::Vector3d u, v;
+  double d_m;
+  Eigen::Matrix3d sqrt_information;
   template <typename T>
-  bool operator()(const T* origin, T* r) const {
-    const Eigen::Matrix<T, 2, 1> b = ToA(origin, centre_b);
-    r[0] = (T(centre_a.x()) - b[0]) * T(inv_sigma);
-    r[1] = (T(centre_a.y()) - b[1]) * T(inv_sigma);
-    // Room frames are defined up to quarter turns: sin(4 d) / 4 is d near each of them.
-    r[2] = sin(T(4.0) * (T(yaw_a) - T(yaw_b) - origin[2])) / T(4.0) * T(inv_sigma_yaw);
+  bool operator()(const T* q, const T* t, const T* n, const T* d, T* r) const {
+    const Eigen::Matrix<T, 3, 3> R = Rotation(q);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> n_self(n), t_self(t);
+    const Eigen::Matrix<T, 3, 1> n_robot = R.transpose() * n_self;
+    // n.p + d = 0 with p = R p_r + t: (R^T n).p_r + (d + n.t) = 0.
+    const T d_robot = d[0] + n_self.dot(t_self);
+    Eigen::Matrix<T, 3, 1> e(u.cast<T>().dot(n_robot), v.cast<T>().dot(n_robot), d_robot - T(d_m));
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(r);
+    residual = sqrt_information.cast<T>() * e;
     return true;
   }
 };
 
-struct WallWallResidual {
-  Eigen::Vector2d n_a, n_b;
-  double d_a, d_b, inv_sigma_angle, inv_sigma_offset;
+struct WallSame {
+  double inv_sigma_rad, inv_sigma_m;
   template <typename T>
-  bool operator()(const T* origin, T* r) const {
-    const T c = cos(origin[2]), s = sin(origin[2]);
-    const Eigen::Matrix<T, 2, 1> n(c * T(n_b.x()) - s * T(n_b.y()),
-                                   s * T(n_b.x()) + c * T(n_b.y()));
-    // n.p + d_b = 0 in map b becomes n'.p' + (d_b - n'.t) = 0 in map a.
-    const T d = T(d_b) - n[0] * origin[0] - n[1] * origin[1];
-    r[0] =
-        (T(n_a.x()) * n[1] - T(n_a.y()) * n[0]) * T(inv_sigma_angle);  // sine of the angle between
-    r[1] = (T(d_a) - d) * T(inv_sigma_offset);
+  bool operator()(const T* n_a, const T* d_a, const T* n_b, const T* d_b, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = (n_b[i] - n_a[i]) * T(inv_sigma_rad);
+    r[3] = (d_b[0] - d_a[0]) * T(inv_sigma_m);
     return true;
   }
 };
 
-struct OriginResidual {
-  double x, y, yaw, inv_sigma, inv_sigma_yaw;
+// A room node (centre in self's frame) against its robot's measurement (robot frame).
+struct RoomMeasured {
+  Eigen::Vector3d centre;
+  double inv_sigma;
   template <typename T>
-  bool operator()(const T* origin, T* r) const {
-    r[0] = (origin[0] - T(x)) * T(inv_sigma);
-    r[1] = (origin[1] - T(y)) * T(inv_sigma);
-    r[2] = sin(origin[2] - T(yaw)) * T(inv_sigma_yaw);
+  bool operator()(const T* q, const T* t, const T* p, T* r) const {
+    const Eigen::Matrix<T, 3, 3> R = Rotation(q);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_self(p), t_self(t);
+    const Eigen::Matrix<T, 3, 1> e = R.transpose() * (p_self - t_self) - centre.cast<T>();
+    for (int i = 0; i < 3; ++i) r[i] = e[i] * T(inv_sigma);
+    return true;
+  }
+};
+
+struct RoomSame {
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* p_a, const T* p_b, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = (p_b[i] - p_a[i]) * T(inv_sigma);
+    return true;
+  }
+};
+
+// The two rooms' x axes (each robot's measured yaw through its origin) agree up to quarter
+// turns: sin(4 delta) / 4 is delta near each of them.
+struct RoomYaw {
+  double yaw_a, yaw_b, inv_sigma;
+  template <typename T>
+  bool operator()(const T* q_a, const T* q_b, T* r) const {
+    const Eigen::Matrix<T, 3, 1> x_a =
+        Rotation(q_a) * Eigen::Matrix<T, 3, 1>(T(std::cos(yaw_a)), T(std::sin(yaw_a)), T(0));
+    const Eigen::Matrix<T, 3, 1> x_b =
+        Rotation(q_b) * Eigen::Matrix<T, 3, 1>(T(std::cos(yaw_b)), T(std::sin(yaw_b)), T(0));
+    const T delta = atan2(x_a[0] * x_b[1] - x_a[1] * x_b[0], x_a[0] * x_b[0] + x_a[1] * x_b[1]);
+    r[0] = sin(T(4.0) * delta) / T(4.0) * T(inv_sigma);
+    return true;
+  }
+};
+
+struct Gravity {
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* q, T* r) const {
+    const Eigen::Matrix<T, 3, 3> R = Rotation(q);
+    r[0] = R(0, 2) * T(inv_sigma);
+    r[1] = R(1, 2) * T(inv_sigma);
+    return true;
+  }
+};
+
+struct OriginMeasured {
+  Eigen::Quaterniond q_m;
+  Eigen::Vector3d t_m;
+  double inv_sigma_m, inv_sigma_rad;
+  template <typename T>
+  bool operator()(const T* q, const T* t, T* r) const {
+    const Eigen::Quaternion<T> e =
+        q_m.conjugate().cast<T>() * Eigen::Quaternion<T>(q[3], q[0], q[1], q[2]);
+    const T sign = e.w() < T(0) ? T(-1) : T(1);
+    for (int i = 0; i < 3; ++i) {
+      r[i] = T(2.0) * sign * e.vec()[i] * T(inv_sigma_rad);
+      r[3 + i] = (t[i] - T(t_m[i])) * T(inv_sigma_m);
+    }
     return true;
   }
 };
@@ -61,8 +116,11 @@ struct OriginResidual {
 }  // namespace
 
 Status CollaborativeGraphConfig::Validate() const {
-  if (max_robots < 1 || max_factors < 1 || !(room_sigma_m > 0) || !(room_yaw_sigma_rad > 0) ||
-      !(wall_sigma_floor_m > 0) || !(wall_sigma_floor_rad > 0) || !(huber > 0) ||
+  const bool positive = room_sigma_m > 0 && room_same_sigma_m > 0 && room_yaw_sigma_rad > 0 &&
+                        wall_sigma_floor_m > 0 && wall_sigma_floor_rad > 0 &&
+                        wall_same_sigma_m > 0 && wall_same_sigma_rad > 0 && gravity_sigma_rad > 0 &&
+                        huber > 0;
+  if (max_robots < 2 || max_walls < 1 || max_rooms < 1 || max_factors < 1 || !positive ||
       max_iterations < 1) {
     return Error{Errc::kInvalidConfig, "collaborative graph: sigmas and limits must be positive"};
   }
@@ -71,106 +129,241 @@ Status CollaborativeGraphConfig::Validate() const {
 
 struct CollaborativeGraph::Impl {
   CollaborativeGraphConfig config;
+  std::uint16_t self = 0;
   std::unique_ptr<ceres::Problem> problem;
   std::unique_ptr<ceres::LossFunction> huber;
-  struct Robot {
-    double origin[3] = {0, 0, 0};
+  ceres::EigenQuaternionManifold quaternion_manifold;
+  ceres::SphereManifold<3> sphere_manifold;
+  struct Origin {
+    double q[4] = {0, 0, 0, 1};
+    double t[3] = {0, 0, 0};
     bool known = false;
+    bool in_problem = false;
     std::size_t factors = 0;
   };
-  std::vector<Robot> robots;
+  struct Wall {
+    std::uint16_t robot = 0;
+    DistilledWall measured;  // in its robot's frame
+    double n[3] = {1, 0, 0};
+    double d = 0;
+  };
+  struct Room {
+    std::uint16_t robot = 0;
+    std::uint32_t id = 0;
+    double yaw_rad = 0;
+    double p[3] = {0, 0, 0};
+  };
+  std::vector<Origin> origins;
+  std::vector<Wall> walls;
+  std::vector<Room> rooms;
   std::size_t factors = 0;
+  // Solve snapshots (sized at Init).
+  std::vector<double> backup;
 
   void Reset() {
     ceres::Problem::Options options;
     options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     problem = std::make_unique<ceres::Problem>(options);
-    for (Robot& r : robots) r.factors = 0;
+    for (Origin& o : origins) {
+      o.in_problem = false;
+      o.factors = 0;
+    }
+    walls.clear();
+    rooms.clear();
     factors = 0;
   }
-  Robot* Get(std::uint16_t robot) {
-    if (robot >= robots.size() || !robots[robot].known) return nullptr;
-    return &robots[robot];
+  Origin* Get(std::uint16_t robot) {
+    if (robot >= origins.size() || !origins[robot].known) return nullptr;
+    return &origins[robot];
+  }
+  // Adds the origin's blocks on first use (self's held constant; the others get gravity).
+  void Use(std::uint16_t robot) {
+    Origin& o = origins[robot];
+    if (o.in_problem) return;
+    o.in_problem = true;
+    problem->AddParameterBlock(o.q, 4, &quaternion_manifold);
+    problem->AddParameterBlock(o.t, 3);
+    if (robot == self) {
+      problem->SetParameterBlockConstant(o.q);
+      problem->SetParameterBlockConstant(o.t);
+      return;
+    }
+    problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Gravity, 2, 4>(new Gravity{1.0 / config.gravity_sigma_rad}),
+        nullptr, o.q);
+  }
+  Eigen::Isometry3d Pose(std::uint16_t robot) const {
+    const Origin& o = origins[robot];
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::Quaterniond(o.q[3], o.q[0], o.q[1], o.q[2]).normalized().toRotationMatrix();
+    T.translation() << o.t[0], o.t[1], o.t[2];
+    return T;
+  }
+  Status HasRoomForFactor() const {
+    if (factors >= config.max_factors)
+      return Error{Errc::kCapacityExceeded, "collaborative graph: factor store full"};
+    return Ok();
   }
 };
 
 CollaborativeGraph::CollaborativeGraph() : impl_(std::make_unique<Impl>()) {}
 CollaborativeGraph::~CollaborativeGraph() = default;
 
-Status CollaborativeGraph::Init(const CollaborativeGraphConfig& config) {
+Status CollaborativeGraph::Init(const CollaborativeGraphConfig& config, std::uint16_t self) {
   if (auto s = config.Validate(); !s) return s;
-  impl_->config = config;
-  impl_->huber = std::make_unique<ceres::HuberLoss>(config.huber);
-  impl_->robots.assign(config.max_robots, Impl::Robot{});
-  impl_->Reset();
+  if (self == 0 || self >= config.max_robots)
+    return Error{Errc::kInvalidConfig, "collaborative graph: self robot id beyond max_robots"};
+  Impl& m = *impl_;
+  m.config = config;
+  m.self = self;
+  m.huber = std::make_unique<ceres::HuberLoss>(config.huber);
+  m.origins.assign(config.max_robots, Impl::Origin{});
+  // Node addresses must not move once Ceres holds them: reserve the capacities.
+  m.walls.reserve(config.max_walls);
+  m.rooms.reserve(config.max_rooms);
+  m.backup.resize(config.max_robots * 7 + config.max_walls * 4 + config.max_rooms * 3);
+  m.Reset();
+  m.origins[self].known = true;
   return Ok();
 }
 
 void CollaborativeGraph::Clear() {
-  for (Impl::Robot& r : impl_->robots) r = Impl::Robot{};
-  impl_->Reset();
+  Impl& m = *impl_;
+  for (std::size_t i = 0; i < m.origins.size(); ++i) {
+    if (i != m.self) m.origins[i] = Impl::Origin{};
+  }
+  m.Reset();
 }
 
 Status CollaborativeGraph::SetInitial(std::uint16_t robot, const Eigen::Isometry3d& T) {
-  if (robot >= impl_->robots.size())
+  Impl& m = *impl_;
+  if (robot >= m.origins.size())
     return Error{Errc::kCapacityExceeded, "collaborative graph: robot id beyond max_robots"};
+  if (robot == m.self) return Error{Errc::kInvalidArgument, "collaborative graph: self is fixed"};
   if (!T.matrix().allFinite())
     return Error{Errc::kInvalidArgument, "collaborative graph: initial origin not finite"};
-  Impl::Robot& r = impl_->robots[robot];
-  r.origin[0] = T.translation().x();
-  r.origin[1] = T.translation().y();
-  r.origin[2] = std::atan2(T.linear()(1, 0), T.linear()(0, 0));
-  r.known = true;
+  Impl::Origin& o = m.origins[robot];
+  const Eigen::Quaterniond q(T.linear());
+  o.q[0] = q.x();
+  o.q[1] = q.y();
+  o.q[2] = q.z();
+  o.q[3] = q.w();
+  for (int i = 0; i < 3; ++i) o.t[i] = T.translation()[i];
+  o.known = true;
   return Ok();
 }
 
-Status CollaborativeGraph::AddRoomRoom(std::uint16_t robot_b,
-                                       const Eigen::Vector2d& centre_a,
-                                       double yaw_a,
-                                       const Eigen::Vector2d& centre_b,
-                                       double yaw_b) {
+Expected<std::uint32_t> CollaborativeGraph::AddWall(std::uint16_t robot, const DistilledWall& w) {
   Impl& m = *impl_;
-  Impl::Robot* r = m.Get(robot_b);
-  if (r == nullptr)
+  Impl::Origin* o = m.Get(robot);
+  if (o == nullptr)
     return Error{Errc::kNotFound, "collaborative graph: robot without an initial origin"};
-  if (!centre_a.allFinite() || !centre_b.allFinite() || !std::isfinite(yaw_a) ||
-      !std::isfinite(yaw_b)) {
-    return Error{Errc::kInvalidArgument, "collaborative graph: room not finite"};
+  for (std::size_t i = 0; i < m.walls.size(); ++i) {
+    if (m.walls[i].robot == robot && m.walls[i].measured.id == w.id)
+      return static_cast<std::uint32_t>(i);
   }
-  if (m.factors >= m.config.max_factors)
-    return Error{Errc::kCapacityExceeded, "collaborative graph: factor store full"};
-  auto* cost = new ceres::AutoDiffCostFunction<RoomRoomResidual, 3, 3>(
-      new RoomRoomResidual{centre_a, centre_b, yaw_a, yaw_b, 1.0 / m.config.room_sigma_m,
-                           1.0 / m.config.room_yaw_sigma_rad});
-  m.problem->AddResidualBlock(cost, m.huber.get(), r->origin);
-  ++r->factors;
+  if (!w.normal.allFinite() || std::fabs(w.normal.norm() - 1.0) > 1e-3 || !std::isfinite(w.d) ||
+      !w.covariance.allFinite()) {
+    return Error{Errc::kInvalidArgument, "collaborative graph: wall not finite or not unit"};
+  }
+  const double floor_m = m.config.wall_sigma_floor_m, floor_rad = m.config.wall_sigma_floor_rad;
+  Eigen::Matrix3d covariance = w.covariance;
+  covariance.diagonal() +=
+      Eigen::Vector3d(floor_rad * floor_rad, floor_rad * floor_rad, floor_m * floor_m);
+  Eigen::LLT<Eigen::Matrix3d> llt(covariance.inverse());
+  if (llt.info() != Eigen::Success)
+    return Error{Errc::kInvalidArgument, "collaborative graph: wall covariance not definite"};
+  if (m.walls.size() >= m.config.max_walls)
+    return Error{Errc::kCapacityExceeded, "collaborative graph: wall store full"};
+  if (auto s = m.HasRoomForFactor(); !s) return s.error();
+  m.Use(robot);
+  Impl::Wall& node = m.walls.emplace_back();
+  node.robot = robot;
+  node.measured = w;
+  const Eigen::Isometry3d T = m.Pose(robot);
+  const Eigen::Vector3d n = T.linear() * w.normal;
+  for (int i = 0; i < 3; ++i) node.n[i] = n[i];
+  node.d = w.d - n.dot(T.translation());
+  Eigen::Vector3d u, v;
+  WallBasis(w.normal, u, v);
+  const Eigen::Matrix3d sqrt_information = llt.matrixU();
+  m.problem->AddParameterBlock(node.n, 3, &m.sphere_manifold);
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<WallMeasured, 3, 4, 3, 3, 1>(
+                                  new WallMeasured{u, v, w.d, sqrt_information}),
+                              m.huber.get(), o->q, o->t, node.n, &node.d);
+  ++o->factors;
+  ++m.factors;
+  return static_cast<std::uint32_t>(m.walls.size() - 1);
+}
+
+Expected<std::uint32_t> CollaborativeGraph::AddRoom(std::uint16_t robot,
+                                                    const DistilledRoom& room,
+                                                    double floor_z_m) {
+  Impl& m = *impl_;
+  Impl::Origin* o = m.Get(robot);
+  if (o == nullptr)
+    return Error{Errc::kNotFound, "collaborative graph: robot without an initial origin"};
+  for (std::size_t i = 0; i < m.rooms.size(); ++i) {
+    if (m.rooms[i].robot == robot && m.rooms[i].id == room.id) return static_cast<std::uint32_t>(i);
+  }
+  if (!room.centre.allFinite() || !std::isfinite(room.yaw_rad) || !std::isfinite(floor_z_m))
+    return Error{Errc::kInvalidArgument, "collaborative graph: room not finite"};
+  if (m.rooms.size() >= m.config.max_rooms)
+    return Error{Errc::kCapacityExceeded, "collaborative graph: room store full"};
+  if (auto s = m.HasRoomForFactor(); !s) return s.error();
+  m.Use(robot);
+  Impl::Room& node = m.rooms.emplace_back();
+  node.robot = robot;
+  node.id = room.id;
+  node.yaw_rad = room.yaw_rad;
+  const Eigen::Vector3d centre(room.centre.x(), room.centre.y(), floor_z_m);
+  const Eigen::Vector3d p = m.Pose(robot) * centre;
+  for (int i = 0; i < 3; ++i) node.p[i] = p[i];
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RoomMeasured, 3, 4, 3, 3>(
+                                  new RoomMeasured{centre, 1.0 / m.config.room_sigma_m}),
+                              m.huber.get(), o->q, o->t, node.p);
+  ++o->factors;
+  ++m.factors;
+  return static_cast<std::uint32_t>(m.rooms.size() - 1);
+}
+
+Status CollaborativeGraph::AddWallWall(std::uint32_t a, std::uint32_t b) {
+  Impl& m = *impl_;
+  if (a >= m.walls.size() || b >= m.walls.size() || a == b)
+    return Error{Errc::kNotFound, "collaborative graph: wall-wall needs two wall nodes"};
+  if (auto s = m.HasRoomForFactor(); !s) return s;
+  Impl::Wall& A = m.walls[a];
+  Impl::Wall& B = m.walls[b];
+  m.problem->AddResidualBlock(
+      new ceres::AutoDiffCostFunction<WallSame, 4, 3, 1, 3, 1>(
+          new WallSame{1.0 / m.config.wall_same_sigma_rad, 1.0 / m.config.wall_same_sigma_m}),
+      m.huber.get(), A.n, &A.d, B.n, &B.d);
+  ++m.origins[A.robot].factors;
+  if (B.robot != A.robot) ++m.origins[B.robot].factors;
   ++m.factors;
   return Ok();
 }
 
-Status CollaborativeGraph::AddWallWall(std::uint16_t robot_b,
-                                       const DistilledWall& a,
-                                       const DistilledWall& b) {
+Status CollaborativeGraph::AddRoomRoom(std::uint32_t a, std::uint32_t b) {
   Impl& m = *impl_;
-  Impl::Robot* r = m.Get(robot_b);
-  if (r == nullptr)
-    return Error{Errc::kNotFound, "collaborative graph: robot without an initial origin"};
-  const double na = a.normal.head<2>().norm(), nb = b.normal.head<2>().norm();
-  if (!(na > 0.5) || !(nb > 0.5) || !std::isfinite(a.d) || !std::isfinite(b.d)) {
-    return Error{Errc::kInvalidArgument, "collaborative graph: wall not vertical or not finite"};
-  }
-  if (m.factors >= m.config.max_factors)
+  if (a >= m.rooms.size() || b >= m.rooms.size() || a == b)
+    return Error{Errc::kNotFound, "collaborative graph: room-room needs two room nodes"};
+  if (m.factors + 2 > m.config.max_factors)
     return Error{Errc::kCapacityExceeded, "collaborative graph: factor store full"};
-  const double sigma_angle =
-      std::sqrt(a.covariance(0, 0) + b.covariance(0, 0) +
-                m.config.wall_sigma_floor_rad * m.config.wall_sigma_floor_rad);
-  const double sigma_offset = std::sqrt(a.covariance(2, 2) + b.covariance(2, 2) +
-                                        m.config.wall_sigma_floor_m * m.config.wall_sigma_floor_m);
-  auto* cost = new ceres::AutoDiffCostFunction<WallWallResidual, 2, 3>(
-      new WallWallResidual{a.normal.head<2>() / na, b.normal.head<2>() / nb, a.d / na, b.d / nb,
-                           1.0 / sigma_angle, 1.0 / sigma_offset});
-  m.problem->AddResidualBlock(cost, m.huber.get(), r->origin);
-  ++r->factors;
+  Impl::Room& A = m.rooms[a];
+  Impl::Room& B = m.rooms[b];
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RoomSame, 3, 3, 3>(
+                                  new RoomSame{1.0 / m.config.room_same_sigma_m}),
+                              m.huber.get(), A.p, B.p);
+  if (A.robot != B.robot) {
+    m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RoomYaw, 1, 4, 4>(new RoomYaw{
+                                    A.yaw_rad, B.yaw_rad, 1.0 / m.config.room_yaw_sigma_rad}),
+                                m.huber.get(), m.origins[A.robot].q, m.origins[B.robot].q);
+    ++m.factors;
+  }
+  ++m.origins[A.robot].factors;
+  if (B.robot != A.robot) ++m.origins[B.robot].factors;
   ++m.factors;
   return Ok();
 }
@@ -180,20 +373,21 @@ Status CollaborativeGraph::AddOriginMeasurement(std::uint16_t robot_b,
                                                 double sigma_m,
                                                 double sigma_rad) {
   Impl& m = *impl_;
-  Impl::Robot* r = m.Get(robot_b);
-  if (r == nullptr)
+  Impl::Origin* o = m.Get(robot_b);
+  if (o == nullptr || robot_b == m.self)
     return Error{Errc::kNotFound, "collaborative graph: robot without an initial origin"};
   if (!T.matrix().allFinite() || !(sigma_m > 0) || !(sigma_rad > 0)) {
     return Error{Errc::kInvalidArgument,
                  "collaborative graph: origin measurement not finite or sigma not positive"};
   }
-  if (m.factors >= m.config.max_factors)
-    return Error{Errc::kCapacityExceeded, "collaborative graph: factor store full"};
-  auto* cost = new ceres::AutoDiffCostFunction<OriginResidual, 3, 3>(new OriginResidual{
-      T.translation().x(), T.translation().y(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)),
-      1.0 / sigma_m, 1.0 / sigma_rad});
-  m.problem->AddResidualBlock(cost, m.huber.get(), r->origin);
-  ++r->factors;
+  if (auto s = m.HasRoomForFactor(); !s) return s;
+  m.Use(robot_b);
+  m.problem->AddResidualBlock(
+      new ceres::AutoDiffCostFunction<OriginMeasured, 6, 4, 3>(
+          new OriginMeasured{Eigen::Quaterniond(T.linear()).normalized(), T.translation(),
+                             1.0 / sigma_m, 1.0 / sigma_rad}),
+      m.huber.get(), o->q, o->t);
+  ++o->factors;
   ++m.factors;
   return Ok();
 }
@@ -201,46 +395,82 @@ Status CollaborativeGraph::AddOriginMeasurement(std::uint16_t robot_b,
 Expected<double> CollaborativeGraph::Solve() {
   Impl& m = *impl_;
   if (m.factors == 0) return 0.0;
+  // Snapshot every value, to restore after a failed solve.
+  std::size_t at = 0;
+  auto save = [&](const double* p, int n) {
+    for (int i = 0; i < n; ++i) m.backup[at++] = p[i];
+  };
+  for (const Impl::Origin& o : m.origins) save(o.q, 4), save(o.t, 3);
+  for (const Impl::Wall& w : m.walls) save(w.n, 3), save(&w.d, 1);
+  for (const Impl::Room& r : m.rooms) save(r.p, 3);
+
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = m.config.max_iterations;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
-  double backup[64][3];
-  const std::size_t n = std::min<std::size_t>(m.robots.size(), 64);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) backup[i][k] = m.robots[i].origin[k];
-  }
   ceres::Solver::Summary summary;
   ceres::Solve(options, m.problem.get(), &summary);
+
   bool finite = std::isfinite(summary.final_cost);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (double v : m.robots[i].origin) finite = finite && std::isfinite(v);
+  for (const Impl::Origin& o : m.origins) {
+    for (double v : o.q) finite = finite && std::isfinite(v);
+    for (double v : o.t) finite = finite && std::isfinite(v);
   }
+  for (const Impl::Wall& w : m.walls)
+    finite = finite && std::isfinite(w.d) && std::isfinite(w.n[0]);
+  for (const Impl::Room& r : m.rooms) finite = finite && std::isfinite(r.p[0]);
   if (!finite || summary.termination_type == ceres::FAILURE) {
-    for (std::size_t i = 0; i < n; ++i) {
-      for (int k = 0; k < 3; ++k) m.robots[i].origin[k] = backup[i][k];
-    }
-    return Error{Errc::kNotConverged, "collaborative graph: solve failed; origins kept"};
+    at = 0;
+    auto load = [&](double* p, int n) {
+      for (int i = 0; i < n; ++i) p[i] = m.backup[at++];
+    };
+    for (Impl::Origin& o : m.origins) load(o.q, 4), load(o.t, 3);
+    for (Impl::Wall& w : m.walls) load(w.n, 3), load(&w.d, 1);
+    for (Impl::Room& r : m.rooms) load(r.p, 3);
+    return Error{Errc::kNotConverged, "collaborative graph: solve failed; values kept"};
   }
   return summary.final_cost;
 }
 
+std::uint16_t CollaborativeGraph::self() const { return impl_->self; }
+
 bool CollaborativeGraph::has_robot(std::uint16_t robot) const {
-  return robot < impl_->robots.size() && impl_->robots[robot].known;
+  return robot < impl_->origins.size() && impl_->origins[robot].known;
 }
 
 Eigen::Isometry3d CollaborativeGraph::T_self_robot(std::uint16_t robot) const {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  if (!has_robot(robot)) return T;
-  const double* o = impl_->robots[robot].origin;
-  T.linear() = Eigen::AngleAxisd(o[2], Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() << o[0], o[1], 0;
-  return T;
+  if (!has_robot(robot)) return Eigen::Isometry3d::Identity();
+  return impl_->Pose(robot);
 }
 
 std::size_t CollaborativeGraph::factors(std::uint16_t robot) const {
-  return robot < impl_->robots.size() ? impl_->robots[robot].factors : 0;
+  return robot < impl_->origins.size() ? impl_->origins[robot].factors : 0;
+}
+
+std::size_t CollaborativeGraph::walls() const { return impl_->walls.size(); }
+std::size_t CollaborativeGraph::rooms() const { return impl_->rooms.size(); }
+
+DistilledWall CollaborativeGraph::wall(std::uint32_t handle) const {
+  const Impl::Wall& w = impl_->walls.at(handle);
+  DistilledWall out = w.measured;
+  out.normal = Eigen::Vector3d(w.n[0], w.n[1], w.n[2]).normalized();
+  out.d = w.d;
+  const Eigen::Isometry3d T = impl_->Pose(w.robot);
+  out.a = (T * Eigen::Vector3d(w.measured.a.x(), w.measured.a.y(), 0)).head<2>();
+  out.b = (T * Eigen::Vector3d(w.measured.b.x(), w.measured.b.y(), 0)).head<2>();
+  return out;
+}
+std::uint16_t CollaborativeGraph::wall_robot(std::uint32_t handle) const {
+  return impl_->walls.at(handle).robot;
+}
+
+Eigen::Vector3d CollaborativeGraph::room_centre(std::uint32_t handle) const {
+  const Impl::Room& r = impl_->rooms.at(handle);
+  return {r.p[0], r.p[1], r.p[2]};
+}
+std::uint16_t CollaborativeGraph::room_robot(std::uint32_t handle) const {
+  return impl_->rooms.at(handle).robot;
 }
 
 }  // namespace msgraphs::core

@@ -17,7 +17,14 @@ namespace {
 
 constexpr std::int32_t kNone = -1;
 
-enum class FactorKind : std::uint8_t { kRelative, kPlane, kRoom, kWallWall, kFloorRoom };
+enum class FactorKind : std::uint8_t {
+  kRelative,
+  kPlane,
+  kRoom,
+  kWallWall,
+  kFloorRoom,
+  kPlanePrior
+};
 
 struct KeyframeNode {
   double q[4] = {0, 0, 0, 1};  // Eigen order: x y z w
@@ -191,6 +198,9 @@ struct SGraph::Impl {
         break;
       case FactorKind::kFloorRoom:
         --stats.floor_factors;
+        break;
+      case FactorKind::kPlanePrior:
+        --stats.plane_prior_factors;
         break;
     }
     free_factor_slots.push_back(slot);  // capacity reserved at Init: no allocation
@@ -580,7 +590,8 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
   // coordinates (u_m.n_k, v_m.n_k, d_k) with respect to the map plane's (alpha, beta, delta_d),
   // n_k = R^T n and d_k = d + n.t, at the keyframe's current estimate.
   Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
-  const Eigen::Vector3d ru = T.linear().transpose() * p.info.basis_u, rv = T.linear().transpose() * p.info.basis_v;
+  const Eigen::Vector3d ru = T.linear().transpose() * p.info.basis_u,
+                        rv = T.linear().transpose() * p.info.basis_v;
   J << z.basis_u.dot(ru), z.basis_u.dot(rv), 0, z.basis_v.dot(ru), z.basis_v.dot(rv), 0,
       p.info.basis_u.dot(T.translation()), p.info.basis_v.dot(T.translation()), 1;
   p.info.information += J.transpose() * information * J;
@@ -707,6 +718,47 @@ Status SGraph::AddWallWall(std::uint32_t a, std::uint32_t b) {
       cost, m.huber_plane.get(), m.planes[a].n, m.planes[a].d, m.planes[b].n, m.planes[b].d);
   ++m.stats.wall_wall_factors;
   return Ok();
+}
+
+Expected<std::uint32_t> SGraph::AddPlanePrior(const PlanePrior& prior) {
+  Impl& m = *impl_;
+  if (!m.ValidPlane(prior.plane) || !m.planes[prior.plane].in_problem) {
+    ++m.stats.rejected_missing_node;
+    return Error{Errc::kNotFound, "plane prior on a missing plane"};
+  }
+  if (!prior.normal.allFinite() || std::fabs(prior.normal.norm() - 1.0) > 1e-3 ||
+      !std::isfinite(prior.d)) {
+    ++m.stats.rejected_pose;
+    return Error{Errc::kInvalidArgument, "plane prior not finite or not unit"};
+  }
+  Eigen::LLT<Eigen::Matrix3d> llt(prior.covariance);
+  if (!prior.covariance.allFinite() || llt.info() != Eigen::Success) {
+    ++m.stats.rejected_information;
+    return Error{Errc::kInvalidArgument, "plane prior covariance not positive definite"};
+  }
+  PlaneNode& p = m.planes[prior.plane];
+  const Eigen::Vector3d n(p.n[0], p.n[1], p.n[2]);
+  if (n.dot(prior.normal) < 0.5) {
+    ++m.stats.rejected_behind;
+    return Error{Errc::kInvalidArgument, "plane prior facing the other way"};
+  }
+  Eigen::Matrix3d information = prior.covariance.inverse();
+  information = 0.5 * (information + information.transpose()).eval();
+  Eigen::LLT<Eigen::Matrix3d> info_llt(information);
+  if (info_llt.info() != Eigen::Success) {
+    ++m.stats.rejected_information;
+    return Error{Errc::kInvalidArgument, "plane prior information not positive definite"};
+  }
+  auto slot = m.NewFactor(FactorKind::kPlanePrior, prior.plane, 0);
+  if (!slot) return slot.error();
+  Eigen::Vector3d u, v;
+  WallBasis(prior.normal, u, v);
+  auto* cost = new ceres::AutoDiffCostFunction<sgraph::PlanePriorResidual, 3, 3, 1>(
+      new sgraph::PlanePriorResidual{u, v, prior.d, Eigen::Matrix3d(info_llt.matrixU())});
+  m.factors[static_cast<std::size_t>(*slot)].id =
+      m.problem->AddResidualBlock(cost, m.huber_plane.get(), p.n, p.d);
+  ++m.stats.plane_prior_factors;
+  return static_cast<std::uint32_t>(*slot);
 }
 
 Status SGraph::SetFloor(const Eigen::Vector2d& centre) {
@@ -851,6 +903,73 @@ MapPlane SGraph::plane(std::uint32_t id) const {
   out.d = p.d[0];
   return out;
 }
+Status SGraph::PlaneMarginals(std::span<const std::uint32_t> ids,
+                              std::span<Eigen::Matrix3d> covariances) const {
+  Impl& m = *impl_;
+  if (covariances.size() < ids.size())
+    return Error{Errc::kCapacityExceeded, "plane marginals: output shorter than the plane list"};
+  // Ceres recovers the marginals from one factorisation of the whole problem (SuiteSparse QR);
+  // it allocates, which is why this runs at the distillation cadence, not per keyframe.
+  std::vector<std::pair<const double*, const double*>> blocks;
+  blocks.reserve(ids.size() * 3);
+  for (std::uint32_t id : ids) {
+    if (id >= m.plane_count || !m.planes[id].in_problem)
+      return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
+    const PlaneNode& p = m.planes[id];
+    blocks.emplace_back(p.n, p.n);
+    blocks.emplace_back(p.n, p.d);
+    blocks.emplace_back(p.d, p.d);
+  }
+  if (ids.empty()) return Ok();
+  // A local solve leaves the nodes outside its window constant, and a constant block has no
+  // covariance: free everything but the origin, as a full solve does (every Solve sets the
+  // flags it needs again).
+  for (std::int32_t k = m.origin; k != kNone; k = m.keyframes[static_cast<std::size_t>(k)].next) {
+    KeyframeNode& node = m.keyframes[static_cast<std::size_t>(k)];
+    m.SetFree(node.q, k != m.origin);
+    m.SetFree(node.t, k != m.origin);
+  }
+  for (std::size_t i = 0; i < m.plane_count; ++i) {
+    if (!m.planes[i].in_problem) continue;
+    m.SetFree(m.planes[i].n, true);
+    m.SetFree(m.planes[i].d, true);
+  }
+  for (std::size_t i = 0; i < m.room_count; ++i) {
+    if (m.rooms[i].in_problem) m.SetFree(m.rooms[i].c, true);
+  }
+  if (m.floor_active) m.SetFree(m.floor_c, true);
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  if (!covariance.Compute(blocks, m.problem.get()))
+    return Error{Errc::kDegenerate, "plane marginals: the problem is rank deficient"};
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const PlaneNode& p = m.planes[ids[i]];
+    // Ambient blocks (normal in R^3, offset), projected on the plane's own (u, v) basis.
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> nn;
+    Eigen::Vector3d nd;
+    double dd = 0;
+    if (!covariance.GetCovarianceBlock(p.n, p.n, nn.data()) ||
+        !covariance.GetCovarianceBlock(p.n, p.d, nd.data()) ||
+        !covariance.GetCovarianceBlock(p.d, p.d, &dd)) {
+      return Error{Errc::kDegenerate, "plane marginals: block not available"};
+    }
+    Eigen::Matrix4d full;
+    full.topLeftCorner<3, 3>() = nn;
+    full.topRightCorner<3, 1>() = nd;
+    full.bottomLeftCorner<1, 3>() = nd.transpose();
+    full(3, 3) = dd;
+    Eigen::Matrix<double, 3, 4> B = Eigen::Matrix<double, 3, 4>::Zero();
+    B.block<1, 3>(0, 0) = p.info.basis_u.transpose();
+    B.block<1, 3>(1, 0) = p.info.basis_v.transpose();
+    B(2, 3) = 1.0;
+    covariances[i] = B * full * B.transpose();
+    if (!covariances[i].allFinite()) return Error{Errc::kDegenerate, "plane marginals: not finite"};
+  }
+  return Ok();
+}
+
 std::size_t SGraph::room_slots() const { return impl_->room_count; }
 MapRoom SGraph::room(std::uint32_t id) const {
   if (id >= impl_->room_count) return MapRoom{};

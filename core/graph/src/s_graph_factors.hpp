@@ -57,6 +57,23 @@ struct PlaneResidual {
   }
 };
 
+/// A prior on a map plane (another robot's measurement of the same wall, through the
+/// collaborative graph): e = [u.n, v.n, d - d_m] with (u, v) spanning the prior's plane.
+struct PlanePriorResidual {
+  Eigen::Vector3d basis_u, basis_v;
+  double d_prior;
+  Eigen::Matrix3d sqrt_information;
+  template <typename T>
+  bool operator()(const T* n, const T* d, T* r) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> nm(n);
+    Eigen::Matrix<T, 3, 1> e(basis_u.cast<T>().dot(nm), basis_v.cast<T>().dot(nm),
+                             d[0] - T(d_prior));
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> res(r);
+    res = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
 /// The midline of two walls facing each other (both normals point into the room): the points
 /// equally far in front of both, (n_a - n_b).p + (d_a - d_b) = 0, in the xy plane.
 template <typename T>

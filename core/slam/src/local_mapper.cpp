@@ -45,7 +45,7 @@ Status LocalMapperConfig::Validate() const {
       !(max_correction_rad > 0) || !(odometry_sigma_min_m > 0) ||
       !(odometry_rotation_sigma_min > 0) || !(odometry_sigma_per_m >= 0) ||
       !(odometry_rotation_sigma_per_m >= 0) || !(odometry_gap_inflation >= 1) ||
-      room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 ||
+      room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 || max_plane_priors < 1 ||
       cloud_store_points < max_scan_points || odometry_capacity < 16 || !(odometry_max_gap_s > 0)) {
     return Error{Errc::kInvalidConfig,
                  "mapper: spacing, voxels, ranges, sigmas and capacities must be positive"};
@@ -88,6 +88,7 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   sequence_.assign(slots, 0);
   keyframe_odometry_.assign(slots, Eigen::Isometry3d::Identity());
   recent_.assign(config.local_map_keyframes, 0);
+  prior_factors_.Init(config.max_plane_priors);
   next_sequence_ = 1;
   have_keyframe_ = false;
   T_map_odom_ = Eigen::Isometry3d::Identity();
@@ -299,6 +300,26 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   T_map_odom_ = graph_.keyframe_pose(id) * T_odom_now.inverse();
   ++stats_.keyframes;
   return ScanOutcome::kKeyframe;
+}
+
+Status LocalMapper::SetPlanePriors(std::span<const PlanePrior> priors) {
+  for (std::uint32_t id : prior_factors_) static_cast<void>(graph_.RemoveFactor(id));
+  prior_factors_.clear();
+  for (const PlanePrior& prior : priors) {
+    if (prior_factors_.full()) {
+      ++stats_.plane_priors_refused;
+      continue;
+    }
+    auto id = graph_.AddPlanePrior(prior);
+    if (!id) {
+      ++stats_.plane_priors_refused;
+      continue;
+    }
+    prior_factors_.push_back(*id);
+  }
+  stats_.plane_priors = prior_factors_.size();
+  keyframes_since_full_ = config_.full_solve_every_keyframes;  // a full solve at the next keyframe
+  return Ok();
 }
 
 Status LocalMapper::Finish() {

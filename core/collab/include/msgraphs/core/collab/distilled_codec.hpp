@@ -3,7 +3,7 @@
 //
 // Little-endian layout (format 1):
 //   "MSDG" | format u8 | flags u8 (bit 0: floor) | robot u16 | version u32 | since u32 |
-//   walls u16 | rooms u16 | [floor x, y: f32 x2] |
+//   walls u16 | rooms u16 | [floor x, y, height z: f32 x3] |
 //   wall  x walls: id u32, version u32, normal f32 x3, d f32, covariance f32 x6 (xx xy xz yy yz
 //   zz),
 //                  extent a, b f32 x4                                      (64 bytes)
@@ -30,6 +30,7 @@ namespace msgraphs::core {
 inline constexpr std::size_t kDistilledHeaderBytes = 20;
 inline constexpr std::size_t kDistilledWallBytes = 64;
 inline constexpr std::size_t kDistilledRoomBytes = 45;
+inline constexpr std::size_t kDistilledFloorBytes = 12;
 
 /// Bytes EncodeDistilled needs for `graph` since `since`.
 std::size_t DistilledEncodedSize(const DistilledGraph& graph, std::uint32_t since);

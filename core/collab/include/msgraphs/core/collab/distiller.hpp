@@ -23,6 +23,13 @@ struct DistillerConfig {
   double resend_distance_m = 0.01;          ///< a wall's offset or a room's centre moved this much
   double resend_angle_rad = 0.0017;         ///< or a normal turned this much (0.1 degree)
   double resend_covariance_ratio = 0.5;     ///< or a wall's uncertainty changed by this factor
+  /// The floor's height in the map frame: the map frame is the first base pose, so minus the
+  /// base's height above the floor (LocalMapperConfig::base_height_m).
+  double floor_z_m = 0;
+  /// Wall covariances as marginals of the whole local optimisation (keyframe uncertainty
+  /// included); otherwise, or when the problem is rank deficient, the plane's own information
+  /// (conditional on the keyframes).
+  bool marginal_covariances = true;
   std::size_t max_walls = 1024;
   std::size_t max_rooms = 256;
   Status Validate() const;
@@ -38,6 +45,10 @@ class Distiller {
   bool Update(const SGraph& graph, const PlaneMapper& planes);
 
   const DistilledGraph& graph() const { return out_; }
+  struct Stats {
+    std::uint64_t marginal_updates = 0, marginal_failures = 0;
+  };
+  const Stats& stats() const { return stats_; }
 
  private:
   DistillerConfig config_;
@@ -45,6 +56,9 @@ class Distiller {
   std::vector<std::int32_t> wall_slot_;  // local plane id -> index in out_.walls, -1 if absent
   std::vector<std::int32_t> room_slot_;  // local room id -> index in out_.rooms, -1 if absent
   std::vector<std::uint8_t> needed_;     // per local plane: a room uses it
+  BoundedVector<std::uint32_t> eligible_;
+  std::vector<Eigen::Matrix3d> marginals_;
+  Stats stats_;
 };
 
 }  // namespace msgraphs::core

@@ -5,8 +5,11 @@
 //   max radius f32 | cells u8 x rings x sectors (heights in cm, 0-2.55 m: a room cloud is cropped
 //   at 2.4 m above the floor) -> 1.2 kB for 20 x 60 instead of 4.8 kB of f32.
 // Cloud: "MSRC" | format u8 | encoding u8 | robot u16 | room u32 | version u32 | step f32 |
-//   points u32 | points as f32 x3 (encoding 0) or as i16 x3 in units of `step` (encoding 1:
-//   quantised at the voxel size's tenth, 6 bytes a point; +-3.2 km at 10 cm voxels).
+//   points u32 | points as f32 x3 (encoding 0), as i16 x3 in units of `step` (encoding 1: 6
+//   bytes a point, +-327 m at 1 cm) or as i8 x3 in units of `step` (encoding 2: 3 bytes a point,
+//   +-6.35 m at 5 cm).
+// Cloud request: "MSRQ" | format u8 | from u16 | to u16 | room u32 | version u32 -> 21 bytes
+//   with the CRC: robot `from` asks robot `to` for the cloud of `room` at `version`.
 // Decoding rejects short or trailing bytes, bad magic, unknown formats or encodings, CRC
 // mismatches, sizes beyond the receiver's capacity, and non-finite values, with a reason.
 #pragma once
@@ -33,7 +36,9 @@ Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& header,
 Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t> bytes,
                                                     ScanContext& descriptor);
 
-enum class CloudEncoding : std::uint8_t { kFloat32 = 0, kQuantised16 = 1 };
+/// kQuantised8: 3 bytes a point, +-127 steps (+-6.35 m at 5 cm: a room cloud in its room frame,
+/// cropped to the walls plus 0.3 m, fits unless the room is wider than 12 m).
+enum class CloudEncoding : std::uint8_t { kFloat32 = 0, kQuantised16 = 1, kQuantised8 = 2 };
 
 struct RoomCloudHeader {
   std::uint16_t robot = 0;
@@ -49,5 +54,14 @@ Expected<std::size_t> EncodeRoomCloud(const RoomCloudHeader& header,
                                       std::span<std::uint8_t> out);
 Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
                                           BoundedVector<Eigen::Vector3f>& points);
+
+struct RoomCloudRequest {
+  std::uint16_t from = 0, to = 0;
+  std::uint32_t room = 0, version = 0;
+};
+inline constexpr std::size_t kRoomCloudRequestBytes = 21;
+Expected<std::size_t> EncodeRoomCloudRequest(const RoomCloudRequest& request,
+                                             std::span<std::uint8_t> out);
+Expected<RoomCloudRequest> DecodeRoomCloudRequest(std::span<const std::uint8_t> bytes);
 
 }  // namespace msgraphs::core

@@ -1,9 +1,17 @@
 // SPDX-License-Identifier: MIT
-// The collaborative S-Graph's solve (paper section VII): every other robot's origin as a free
-// node in this robot's map frame, tied by room-to-room and wall-to-wall factors from accepted
-// room matches. Robots walk level floors in gravity-aligned odometry frames, so an origin is
-// planar: x, y and yaw (z, roll and pitch are zero by construction of the frames).
-// Ceres is private; factors carry Huber kernels.
+// The collaborative S-Graph (paper section VII), held by one robot ("self"):
+// - every robot's origin (its map frame in self's map frame) is a free SE(3) node; self's is
+//   the gauge, fixed at identity;
+// - walls and rooms of every robot are nodes in self's map frame, each tied to its robot's
+//   origin by what that robot measured (the distilled estimate, with its covariance);
+// - room-to-room (same centre, orientation equal up to quarter turns) and wall-to-wall (same
+//   plane) factors join the nodes of accepted matches; a fine alignment adds a direct
+//   measurement of an origin;
+// - a weak gravity factor per origin: every robot's map frame is gravity-aligned (its IMU),
+//   which fixes roll and pitch when the matched rooms alone would not.
+// One global solve estimates every origin and refines every wall and room from all robots'
+// measurements. Ceres is private; every factor has a Huber kernel. Capacities are fixed at
+// Init; a full store refuses with kCapacityExceeded.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -16,12 +24,18 @@
 namespace msgraphs::core {
 
 struct CollaborativeGraphConfig {
-  std::size_t max_robots = 16;
-  std::size_t max_factors = 4096;
-  double room_sigma_m = 0.10;        ///< room centres of the same room seen by two robots
-  double room_yaw_sigma_rad = 0.05;  ///< room orientation (modulo quarter turns)
-  double wall_sigma_floor_m = 0.02;  ///< added to the walls' own offset uncertainty
-  double wall_sigma_floor_rad = 0.01;
+  std::size_t max_robots = 16;   ///< robot ids 1 .. max_robots - 1
+  std::size_t max_walls = 2048;  ///< nodes, all robots together
+  std::size_t max_rooms = 512;
+  std::size_t max_factors = 8192;
+  double room_sigma_m = 0.07;         ///< a room centre as its robot measured it
+  double room_same_sigma_m = 0.01;    ///< two nodes of the same room
+  double room_yaw_sigma_rad = 0.05;   ///< room orientation (modulo quarter turns)
+  double wall_sigma_floor_m = 0.014;  ///< added to the walls' own offset uncertainty
+  double wall_sigma_floor_rad = 0.007;
+  double wall_same_sigma_m = 0.005;  ///< two nodes of the same wall
+  double wall_same_sigma_rad = 0.002;
+  double gravity_sigma_rad = 0.02;  ///< how level each robot's map frame is
   double huber = 2.0;
   int max_iterations = 50;
   Status Validate() const;
@@ -34,35 +48,46 @@ class CollaborativeGraph {
   CollaborativeGraph(const CollaborativeGraph&) = delete;
   CollaborativeGraph& operator=(const CollaborativeGraph&) = delete;
 
-  Status Init(const CollaborativeGraphConfig& config);
-  /// Drops every factor and origin (the accepted matches changed: rebuilt from them).
+  Status Init(const CollaborativeGraphConfig& config, std::uint16_t self_robot);
+  /// Drops every node and factor except self's origin (rebuilt from the accepted matches).
   void Clear();
 
-  /// Starts (or restarts) robot `robot`'s origin at T_self_robot (projected to x, y, yaw).
+  /// Starts (or restarts) robot `robot`'s origin at T_self_robot.
   Status SetInitial(std::uint16_t robot, const Eigen::Isometry3d& T_self_robot);
-  /// The same room: its centre and yaw in this robot's map (a) and in robot b's map.
-  Status AddRoomRoom(std::uint16_t robot_b,
-                     const Eigen::Vector2d& centre_a,
-                     double yaw_a,
-                     const Eigen::Vector2d& centre_b,
-                     double yaw_b);
-  /// The same wall, in each robot's map, with each side's covariance.
-  Status AddWallWall(std::uint16_t robot_b,
-                     const DistilledWall& wall_a,
-                     const DistilledWall& wall_b);
 
+  /// Robot `robot`'s wall as it measured it (its map frame, its covariance); returns the node's
+  /// handle (the same handle when that wall is already a node). The robot needs an origin.
+  Expected<std::uint32_t> AddWall(std::uint16_t robot, const DistilledWall& wall);
+  /// Robot `robot`'s room (centre and yaw in its map frame, on its floor at floor_z_m).
+  Expected<std::uint32_t> AddRoom(std::uint16_t robot, const DistilledRoom& room, double floor_z_m);
+
+  /// Two wall nodes are the same plane.
+  Status AddWallWall(std::uint32_t wall_a, std::uint32_t wall_b);
+  /// Two room nodes are the same room: same centre, frames equal up to quarter turns.
+  Status AddRoomRoom(std::uint32_t room_a, std::uint32_t room_b);
   /// A direct measurement of robot b's origin (a fine alignment of one room's clouds).
   Status AddOriginMeasurement(std::uint16_t robot_b,
                               const Eigen::Isometry3d& T_self_robot,
                               double sigma_m,
                               double sigma_rad);
 
-  /// Solves; returns the final cost. Robots without factors keep their initial values.
+  /// Solves; returns the final cost. A failed or non-finite solve restores the previous values.
   Expected<double> Solve();
 
+  std::uint16_t self() const;
   bool has_robot(std::uint16_t robot) const;
   Eigen::Isometry3d T_self_robot(std::uint16_t robot) const;
+  /// Factors that touch robot `robot`'s origin or its nodes.
   std::size_t factors(std::uint16_t robot) const;
+  std::size_t walls() const;
+  std::size_t rooms() const;
+  /// A wall node's estimate in self's map frame (id and extent as its robot sent them; extent
+  /// mapped through the origin).
+  DistilledWall wall(std::uint32_t handle) const;
+  std::uint16_t wall_robot(std::uint32_t handle) const;
+  /// A room node's centre in self's map frame.
+  Eigen::Vector3d room_centre(std::uint32_t handle) const;
+  std::uint16_t room_robot(std::uint32_t handle) const;
 
  private:
   struct Impl;

@@ -42,6 +42,7 @@ struct DistilledGraph {
   BoundedVector<DistilledRoom> rooms;
   bool has_floor = false;
   Eigen::Vector2d floor_centre = Eigen::Vector2d::Zero();
+  double floor_z_m = 0;  ///< the floor's height in this robot's map frame (room frames sit on it)
 
   void Init(std::size_t max_walls, std::size_t max_rooms) {
     walls.Init(max_walls);
@@ -52,6 +53,12 @@ struct DistilledGraph {
   const DistilledWall* FindWall(std::uint32_t id) const {
     for (const DistilledWall& w : walls) {
       if (w.id == id) return &w;
+    }
+    return nullptr;
+  }
+  const DistilledRoom* FindRoom(std::uint32_t id) const {
+    for (const DistilledRoom& r : rooms) {
+      if (r.id == id) return &r;
     }
     return nullptr;
   }

@@ -76,6 +76,15 @@ struct PlaneMeasurement {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
 };
 
+/// An external measurement of a map plane: normal and offset in this map frame, covariance over
+/// (alpha, beta, delta_d) along WallBasis(normal) (distilled_graph.hpp).
+struct PlanePrior {
+  std::uint32_t plane = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+  double d = 0;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+
 struct MapPlane {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit; the side it was seen from
   double d = 0;
@@ -118,7 +127,8 @@ struct SGraphStats {
   std::size_t planes = 0, rooms = 0, floors = 0;
   std::size_t factors = 0, factors_peak = 0;
   std::array<std::size_t, 4> relative_factors{};  ///< by RelativePoseKind
-  std::size_t plane_factors = 0, room_factors = 0, wall_wall_factors = 0, floor_factors = 0;
+  std::size_t plane_factors = 0, room_factors = 0, wall_wall_factors = 0, floor_factors = 0,
+              plane_prior_factors = 0;
   // Refused input, by reason.
   std::uint64_t rejected_pose = 0;          ///< non-finite or non-rigid pose or measurement
   std::uint64_t rejected_stamp = 0;         ///< keyframe stamp not after the previous one
@@ -183,6 +193,9 @@ class SGraph {
 
   /// Two landmarks found to be the same wall: ties them together.
   Status AddWallWall(std::uint32_t plane_a, std::uint32_t plane_b);
+  /// A prior on a plane from outside this graph (another robot's measurement of the same wall,
+  /// through the collaborative graph). Returns the factor's id (RemoveFactor replaces it).
+  Expected<std::uint32_t> AddPlanePrior(const PlanePrior& prior);
 
   /// Creates the floor node (once) at `centre`, or moves its estimate. Each room joins it with
   /// a weak factor through AddFloorRoom.
@@ -198,6 +211,12 @@ class SGraph {
   double keyframe_stamp(std::uint32_t id) const;
   std::size_t plane_slots() const;
   MapPlane plane(std::uint32_t id) const;
+  /// Marginal covariances of planes `ids` from the whole optimisation (the uncertainty of the
+  /// keyframes that saw them included), over (alpha, beta, delta_d) along each plane's basis_u /
+  /// basis_v. kDegenerate when the problem is rank deficient. Allocates (Ceres): call it at the
+  /// distillation cadence, not on the per-keyframe path.
+  Status PlaneMarginals(std::span<const std::uint32_t> ids,
+                        std::span<Eigen::Matrix3d> covariances) const;
   std::size_t room_slots() const;
   MapRoom room(std::uint32_t id) const;
   bool has_floor() const;

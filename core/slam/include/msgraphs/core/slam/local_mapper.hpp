@@ -65,6 +65,7 @@ struct LocalMapperConfig {
   double odometry_gap_inflation = 10.0;  ///< sigma factor when the odometry bridged a gap
   std::size_t room_update_every_keyframes = 5;
   std::size_t full_solve_every_keyframes = 50;
+  std::size_t max_plane_priors = 256;  ///< external wall priors held at once (SetPlanePriors)
   std::size_t cloud_store_points = 1500000;
   std::size_t odometry_capacity = 4096;
   double odometry_max_gap_s = 0.1;
@@ -119,6 +120,8 @@ struct LocalMapperStats {
   std::uint64_t scan_match_rejected_fitness = 0, scan_match_rejected_overlap = 0,
                 scan_match_rejected_diverged = 0, scan_match_rejected_failed = 0;
   std::uint64_t loop_closures = 0, full_solves = 0;
+  std::size_t plane_priors = 0;            ///< external wall priors in the graph now
+  std::uint64_t plane_priors_refused = 0;  ///< beyond max_plane_priors, or refused by the graph
   std::size_t local_map_points_peak = 0;
 };
 
@@ -134,6 +137,11 @@ class LocalMapper {
 
   /// A full solve now (for example at the end of a mission).
   Status Finish();
+
+  /// Replaces the external priors on this robot's walls (other robots' measurements of the same
+  /// walls through the collaborative graph, CollabSession::PlanePriors). The next keyframe runs
+  /// a full solve. Priors the graph refuses, or beyond max_plane_priors, are counted.
+  Status SetPlanePriors(std::span<const PlanePrior> priors);
 
   const SGraph& graph() const { return graph_; }
   /// The map-from-odometry correction at the newest keyframe: T_map_base = T_map_odom *
@@ -188,6 +196,7 @@ class LocalMapper {
   std::vector<std::uint64_t> sequence_;               // per keyframe slot
   std::vector<Eigen::Isometry3d> keyframe_odometry_;  // per keyframe slot
   std::vector<std::uint32_t> recent_;
+  BoundedVector<std::uint32_t> prior_factors_;  // factor ids of the current plane priors
   std::uint64_t next_sequence_ = 1;
   bool have_keyframe_ = false;
   std::uint32_t last_keyframe_ = 0;

@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: MIT
+// One robot's side of Multi S-Graphs, transport-agnostic: what the onboard node runs between
+// its local S-Graph and the radio link, and what msgraphs_collab runs between in-process robots.
+//
+// - Publish(mapper): distils the local graph and sends what changed since the last Publish, and
+//   the descriptor of every new or significantly changed room (its room cloud is kept to answer
+//   requests for it).
+// - Receive(type, bytes): decodes a peer's message (every decoder checks it; a malformed one
+//   is counted by type and dropped). A room cloud request is answered at once.
+// - Match(): proposes room pairs by Scan Context distance, requests the peer's room cloud for
+//   fine alignment (modes with fine alignment), aligns when it has arrived, checks candidates
+//   of anchored robot pairs against the merged estimate, keeps the largest mutually consistent
+//   set of matches per peer and solves the collaborative graph when they changed.
+//
+// Bounded: every store is sized at Init (capacities in CollabSessionConfig; the byte figure is
+// in stats()). Full stores refuse with a counter: a peer beyond max_peers is ignored, a room
+// beyond max_rooms gets no descriptor, a room cloud beyond max_room_points is not described,
+// a peer's descriptor beyond max_peer_rooms is dropped, matches beyond max_matches_per_peer are
+// dropped, the peer cloud cache evicts its oldest entry. Not thread-safe: the caller serialises.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/collab/distiller.hpp"
+#include "msgraphs/core/collab/room_descriptor.hpp"
+#include "msgraphs/core/collab/room_matcher.hpp"
+#include "msgraphs/core/collab/room_messages.hpp"
+#include "msgraphs/core/graph/collaborative_graph.hpp"
+#include "msgraphs/core/slam/local_mapper.hpp"
+
+namespace msgraphs::core {
+
+enum class CollabMessageType : std::uint8_t {
+  kDistilledGraph = 0,
+  kRoomDescriptor = 1,
+  kRoomCloudRequest = 2,
+  kRoomCloud = 3,
+};
+inline constexpr int kCollabMessageTypes = 4;
+const char* CollabMessageTypeName(CollabMessageType type);
+
+/// The paper's ablation modes.
+struct CollabMode {
+  bool walls = true;  ///< wall-to-wall factors beside room-to-room
+  bool fine = true;   ///< fine alignment of room clouds before a match is accepted
+};
+
+/// Where the session's messages go. `to` is a robot id, or 0 for every peer.
+class CollabOutbox {
+ public:
+  virtual ~CollabOutbox() = default;
+  virtual void Send(CollabMessageType type,
+                    std::uint16_t to,
+                    std::span<const std::uint8_t> bytes) = 0;
+};
+
+struct CollabSessionConfig {
+  std::uint16_t robot = 1;  ///< this robot's id (1..65535)
+  CollabMode mode;
+  CloudEncoding cloud_encoding = CloudEncoding::kQuantised16;
+  float cloud_step_m = 0.01f;  ///< kQuantised16 / kQuantised8 step (kQuantised8: 0.05 fits rooms)
+  /// kQuantised8: a room wider than 254 steps gets a coarser step, up to this; beyond it, 16 bits.
+  float max_cloud_step_m = 0.125f;
+  std::size_t max_peers = 8;
+  std::size_t max_rooms = 64;           ///< own rooms with a descriptor and a room cloud
+  std::size_t max_room_points = 12000;  ///< 2x the largest measured (5,800 at 0.2 m voxels)
+  std::size_t max_peer_rooms = 128;     ///< descriptors held per peer
+  std::size_t max_pending = 64;         ///< proposals waiting for a room cloud, per peer
+  std::size_t max_matches_per_peer = 64;
+  std::size_t cloud_cache = 16;  ///< peer room clouds kept for later proposals
+  std::size_t max_message_bytes = 1 << 20;
+  /// A room's descriptor is rebuilt and sent again when its walls changed or its centre or size
+  /// moved by more than this (its distilled entry follows every centimetre).
+  double descriptor_resend_m = 0.3;
+  /// From this many consistent matches on, a new candidate of that peer is checked against the
+  /// merged estimate instead of by fine alignment: no room cloud crosses the radio.
+  std::size_t anchored_matches = 3;
+  double anchored_translation_m = 0.5;
+  double anchored_rotation_rad = 0.1;
+  /// A fine alignment measures the origin directly; its sigma (room clouds carry map error).
+  double fine_origin_sigma_m = 0.03;
+  double fine_origin_sigma_rad = 0.005;
+  /// Match() calls after which an unanswered room cloud request is sent again.
+  std::uint32_t request_retry_calls = 3;
+  double wall_pair_angle_rad = 0.26;  ///< walls of matched rooms paired within this angle
+  double wall_pair_offset_m = 0.3;    ///< and this offset after the match transform
+  std::size_t max_wall_pairs = 512;   ///< matched wall pairs held for PlanePriors
+  /// PlanePriors: the peer's wall covariance times `feedback_inflation` plus these floors for
+  /// the origin's uncertainty. Inflated because the peer's marginals may already hold what this
+  /// robot told it (each robot feeds the other's walls back into its own map).
+  double feedback_inflation = 2.0;
+  double feedback_sigma_floor_m = 0.01;
+  double feedback_sigma_floor_rad = 0.005;
+  DistillerConfig distiller;
+  RoomDescriptorConfig descriptor;
+  RoomMatchConfig matcher;
+  CollaborativeGraphConfig graph;
+  Status Validate() const;
+};
+
+struct CollabPeerStats {
+  std::uint16_t robot = 0;
+  bool merged = false;
+  std::uint32_t graph_version = 0;
+  std::size_t walls = 0, rooms = 0, descriptors = 0;
+  std::size_t matches = 0, consistent = 0;
+  std::uint64_t bytes_received[kCollabMessageTypes] = {};
+  std::uint64_t messages_received[kCollabMessageTypes] = {};
+  std::uint64_t malformed = 0;   ///< rejected by a decoder, any type
+  std::uint64_t graph_gaps = 0;  ///< deltas whose base this robot had not received
+};
+
+struct CollabSessionStats {
+  std::size_t peers = 0, peers_peak = 0;
+  std::size_t own_rooms = 0, own_rooms_peak = 0;
+  std::size_t room_points_peak = 0;
+  std::uint64_t bytes_sent[kCollabMessageTypes] = {};
+  std::uint64_t messages_sent[kCollabMessageTypes] = {};
+  std::uint64_t proposals = 0;      ///< Scan Context pairs below SC_th
+  std::uint64_t rejected_fine = 0;  ///< fine alignment above ICP_th
+  std::uint64_t checked_anchored = 0, rejected_anchored = 0;
+  std::uint64_t rejected_consistency = 0;  ///< currently outside the consistent sets
+  std::uint64_t accepted = 0;              ///< currently inside them
+  std::uint64_t solves = 0, solve_failures = 0;
+  /// Distillations with marginal wall covariances, and those that fell back to conditional ones.
+  std::uint64_t marginal_updates = 0, marginal_failures = 0;
+  std::uint64_t requests_sent = 0, requests_served = 0, requests_unknown = 0;
+  // Refusals of full stores (see the header comment).
+  std::uint64_t peers_refused = 0, rooms_refused = 0, room_clouds_too_large = 0,
+                descriptors_refused = 0, pending_refused = 0, matches_refused = 0,
+                cache_evictions = 0, descriptors_mismatched = 0, encode_failures = 0,
+                clouds_unsolicited = 0, wall_pairs_refused = 0;
+  /// Walls and rooms the collaborative graph could not hold at the last solve (its capacity, or
+  /// a non-finite element).
+  std::uint64_t graph_refused = 0;
+  std::uint64_t cloud_encoding_fallbacks = 0;  ///< room clouds sent in 16 bits: too wide for 8
+  std::uint64_t malformed = 0;
+  std::size_t store_bytes = 0;
+};
+
+class CollabSession {
+ public:
+  CollabSession();
+  ~CollabSession();
+  CollabSession(const CollabSession&) = delete;
+  CollabSession& operator=(const CollabSession&) = delete;
+
+  /// `graph` gives the capacities of the local S-Graph; `floor_z_map_m` where the floor is in
+  /// this robot's map frame (the map frame is the first base pose, so minus the base height).
+  Status Init(const CollabSessionConfig& config, const SGraphConfig& graph, double floor_z_map_m);
+
+  /// Distils and sends what changed; descriptors of new or changed rooms.
+  Status Publish(const LocalMapper& mapper, CollabOutbox& out);
+  /// The next Publish sends the whole graph and every descriptor again (a peer joined late).
+  void ResendAll();
+
+  /// A message from the link. Malformed ones return the decoder's error and are counted.
+  Status Receive(CollabMessageType type, std::span<const std::uint8_t> bytes, CollabOutbox& out);
+
+  /// Proposes, aligns, checks and solves; returns true when the estimate of an origin changed.
+  bool Match(CollabOutbox& out);
+
+  const DistilledGraph& distilled() const;
+  bool merged(std::uint16_t robot) const;
+  /// Robot `robot`'s map frame in this robot's map frame (identity for this robot).
+  Eigen::Isometry3d T_self_robot(std::uint16_t robot) const;
+  /// The peer's distilled graph as received (nullptr for unknown robots).
+  const DistilledGraph* peer_graph(std::uint16_t robot) const;
+  /// Accepted matches with `robot` (the consistent set), into `out`; returns how many.
+  std::size_t ConsistentMatches(std::uint16_t robot, std::span<RoomMatch> out) const;
+  /// Every match with `robot` that passed its check (consistent or not).
+  std::size_t AllMatches(std::uint16_t robot, std::span<RoomMatch> out) const;
+  const CollaborativeGraph& collaborative_graph() const;
+  /// Other robots' measurements of this robot's matched walls, through the merged origins: the
+  /// priors that feed the collaborative estimate back into the local S-Graph
+  /// (LocalMapper::SetPlanePriors). Returns how many were written into `out`.
+  std::size_t PlanePriors(std::span<PlanePrior> out) const;
+
+  std::size_t peers() const;
+  CollabPeerStats peer_stats(std::size_t index) const;
+  const CollabSessionStats& stats() const;
+  const CollabSessionConfig& config() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace msgraphs::core
