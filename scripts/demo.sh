@@ -22,6 +22,6 @@ tests/runtime/heartbeat_processes_test.sh "$node" 3 91
 echo
 echo "What this shows: the build, the platform layer and the DDS link between real processes."
 echo "Built and tested but not yet joined into the node: drivers, simulator, perception, pose graphs and"
-echo "the local S-Graph (docs/s-graph.md: tools/msgraphs_slam maps one simulated robot to 0.7-3.6 cm ATE)."
+echo "the local S-Graph (docs/s-graph.md: tools/msgraphs_slam maps one simulated robot to 0.5-3.2 cm ATE)."
 echo "Room matching and the collaborative graph run in tools/msgraphs_collab (docs/multi-robot.md);"
 echo "the node's map exchange over Fast DDS and the multi-robot demo are still open: see 'issues'."

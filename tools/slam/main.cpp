@@ -346,12 +346,13 @@ int main(int argc, char** argv) {
   std::printf(
       "planes: %llu associated, %llu created, %llu furniture faces skipped, %llu refused; rooms: "
       "%llu updates, %llu detections, %llu created, %llu matched, %llu corridors completed, %llu "
-      "wall-wall\n",
+      "wall-wall; floor found only by the floor search at %llu keyframes\n",
       static_cast<unsigned long long>(ps.associated), static_cast<unsigned long long>(ps.created),
       static_cast<unsigned long long>(ps.furniture), static_cast<unsigned long long>(ps.rejected),
       static_cast<unsigned long long>(rs.updates), static_cast<unsigned long long>(rs.detections),
       static_cast<unsigned long long>(rs.created), static_cast<unsigned long long>(rs.matched),
-      static_cast<unsigned long long>(rs.upgraded), static_cast<unsigned long long>(rs.wall_wall));
+      static_cast<unsigned long long>(rs.upgraded), static_cast<unsigned long long>(rs.wall_wall),
+      static_cast<unsigned long long>(mapper.stats().floors_found));
   if (world) {
     std::printf(
         "against the world: %zu of %zu mapped walls are true faces (mean offset %.3f m); %zu of "

@@ -89,6 +89,7 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   keyframe_odometry_.assign(slots, Eigen::Isometry3d::Identity());
   recent_.assign(config.local_map_keyframes, 0);
   prior_factors_.Init(config.max_plane_priors);
+  floor_members_.Init(config.max_scan_points);
   next_sequence_ = 1;
   have_keyframe_ = false;
   T_map_odom_ = Eigen::Isometry3d::Identity();
@@ -251,7 +252,7 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     path_m_ += delta.translation().norm();
   }
   // Planes.
-  static_cast<void>(extractor_.Extract(down_.span(), normals_.span(), config_.planes, planes_));
+  ExtractPlanes();
   static_cast<void>(planes_mapper_.Associate(graph_, id, planes_.span()));
   Stage(observer, MapperStage::kPlanes);
   // Stored cloud and descriptor.
@@ -300,6 +301,50 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   T_map_odom_ = graph_.keyframe_pose(id) * T_odom_now.inverse();
   ++stats_.keyframes;
   return ScanOutcome::kKeyframe;
+}
+
+void LocalMapper::ExtractPlanes() {
+  static_cast<void>(extractor_.Extract(down_.span(), normals_.span(), config_.planes, planes_));
+  // Did the general search find the floor under the robot (base frame: z = -base_height_m)?
+  for (const ExtractedPlane& p : planes_) {
+    if (p.kind == PlaneKind::kHorizontal && p.normal.z() > 0 &&
+        std::fabs(p.d - config_.base_height_m) <= config_.floor_band_m) {
+      return;
+    }
+  }
+  // If not, look for it where it must be: the far floor rings are too sparse for the point
+  // normals the general search relies on (clutter hides the near ones).
+  floor_members_.clear();
+  const auto floor_z = static_cast<float>(-config_.base_height_m);
+  for (std::uint32_t i = 0; i < down_.size(); ++i) {
+    // Loose on the normal (sparse rings make it noisy) but not on walls: their bottom strip is
+    // in the band too, and would tilt the fit towards them.
+    if (std::fabs(down_[i].z() - floor_z) <= static_cast<float>(config_.floor_band_m) &&
+        std::fabs(normals_[i].z()) >= static_cast<float>(config_.floor_min_normal_z))
+      static_cast<void>(floor_members_.try_push_back(i));
+  }
+  ExtractedPlane floor;
+  if (floor_members_.size() < config_.floor_min_points ||
+      !extractor_.Fit(down_.span(), floor_members_.span(), config_.planes, floor)) {
+    return;
+  }
+  // Once more with the points near the fitted plane (drops kerbs and debris in the band).
+  const Eigen::Vector3f n = floor.normal.cast<float>();
+  const auto d = static_cast<float>(floor.d);
+  std::size_t kept = 0;
+  for (std::uint32_t i : floor_members_) {
+    if (std::fabs(n.dot(down_[i]) + d) <= static_cast<float>(config_.floor_fit_band_m))
+      floor_members_[kept++] = i;
+  }
+  floor_members_.resize_down(kept);
+  if (kept < config_.floor_min_points ||
+      !extractor_.Fit(down_.span(), floor_members_.span(), config_.planes, floor) ||
+      floor.normal.z() < std::cos(config_.floor_max_tilt_deg * 3.14159265358979 / 180.0)) {
+    return;
+  }
+  floor.kind = PlaneKind::kHorizontal;
+  if (!planes_.try_push_back(floor)) planes_[planes_.size() - 1] = floor;  // the floor matters most
+  ++stats_.floors_found;
 }
 
 Status LocalMapper::SetPlanePriors(std::span<const PlanePrior> priors) {

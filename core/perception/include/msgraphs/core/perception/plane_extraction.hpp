@@ -49,13 +49,13 @@ struct PlaneExtractionConfig {
   float distance_threshold_m = 0.06f;  ///< inlier distance: 2 sigma of the VLP-16's 3 cm noise
   float normal_threshold_deg = 25.0f;  ///< inlier point normals must agree this well
   int ransac_iterations = 200;
-  std::size_t score_subset = 1500;     ///< points a hypothesis is scored on
+  std::size_t score_subset = 1500;  ///< points a hypothesis is scored on
   std::size_t min_vertical_inliers = 100;
   std::size_t min_horizontal_inliers = 500;
   float max_tilt_deg = 15.0f;  ///< vertical: normal within this of horizontal; horizontal: of z
   float segment_gap_m = 1.0f;  ///< a wall's points split where they leave a larger gap
   std::size_t max_planes = 48;
-  float min_sigma_m = 0.01f;   ///< floor on the residual sigma used for the covariance
+  float min_sigma_m = 0.01f;  ///< floor on the residual sigma used for the covariance
   std::uint64_t seed = 1;
 
   Status Validate() const;
@@ -68,12 +68,24 @@ class PlaneExtractor {
   /// Points in the sensor (keyframe) frame and their normals (zero normals are skipped).
   /// Appends to `planes` (cleared first); kCapacityExceeded when it fills up (the planes found
   /// so far are kept).
-  Status Extract(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Vector3f> normals,
-                 const PlaneExtractionConfig& config, BoundedVector<ExtractedPlane>& planes);
+  Status Extract(std::span<const Eigen::Vector3f> points,
+                 std::span<const Eigen::Vector3f> normals,
+                 const PlaneExtractionConfig& config,
+                 BoundedVector<ExtractedPlane>& planes);
+
+  /// The plane of points[members] (PCA), with its covariance, normal towards the frame origin.
+  bool Fit(std::span<const Eigen::Vector3f> points,
+           std::span<const std::uint32_t> members,
+           const PlaneExtractionConfig& config,
+           ExtractedPlane& plane) const {
+    return FitAndDescribe(points, members, config, plane);
+  }
 
  private:
-  bool FitAndDescribe(std::span<const Eigen::Vector3f> points, std::span<const std::uint32_t> members,
-                      const PlaneExtractionConfig& config, ExtractedPlane& plane) const;
+  bool FitAndDescribe(std::span<const Eigen::Vector3f> points,
+                      std::span<const std::uint32_t> members,
+                      const PlaneExtractionConfig& config,
+                      ExtractedPlane& plane) const;
 
   std::vector<std::uint32_t> remaining_;
   std::vector<std::uint32_t> inliers_;

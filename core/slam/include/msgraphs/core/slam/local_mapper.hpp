@@ -45,6 +45,14 @@ namespace msgraphs::core {
 struct LocalMapperConfig {
   Eigen::Isometry3d T_base_lidar = Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.30));
   double base_height_m = 0.5;  ///< base frame above the floor (Spot walking)
+  /// When the general plane search misses the floor under a legged robot (far floor rings are
+  /// too sparse for the point normals it needs, and clutter hides the near ones), it is looked
+  /// for where it must be: points within floor_band_m of base_height_m below the base, refitted
+  /// once and kept within floor_fit_band_m, at least floor_min_points, tilted at most
+  /// floor_max_tilt_deg.
+  double floor_band_m = 0.12, floor_fit_band_m = 0.05, floor_max_tilt_deg = 3.0;
+  double floor_min_normal_z = 0.7;  ///< a floor point's normal is at most 45 degrees off vertical
+  std::size_t floor_min_points = 150;
   double keyframe_spacing_m = 1.0;
   double keyframe_angle_rad = 0.35;
   float min_range_m = 0.5f, max_range_m = 25.0f;
@@ -122,6 +130,7 @@ struct LocalMapperStats {
   std::uint64_t loop_closures = 0, full_solves = 0;
   std::size_t plane_priors = 0;            ///< external wall priors in the graph now
   std::uint64_t plane_priors_refused = 0;  ///< beyond max_plane_priors, or refused by the graph
+  std::uint64_t floors_found = 0;          ///< keyframes whose floor only the floor search found
   std::size_t local_map_points_peak = 0;
 };
 
@@ -174,6 +183,7 @@ class LocalMapper {
                   const Eigen::Isometry3d& T_odom_end);
   bool BuildLocalMap(std::uint32_t last);
   Matrix6d OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const;
+  void ExtractPlanes();
 
   LocalMapperConfig config_;
   SGraph graph_;
@@ -192,6 +202,7 @@ class LocalMapper {
       local_points_, local_normals_, world_points_;
   BoundedVector<Eigen::Matrix3f> covariances_, local_covariances_;
   BoundedVector<float> times_;
+  BoundedVector<std::uint32_t> floor_members_;
   BoundedVector<ExtractedPlane> planes_;
   std::vector<std::uint64_t> sequence_;               // per keyframe slot
   std::vector<Eigen::Isometry3d> keyframe_odometry_;  // per keyframe slot
