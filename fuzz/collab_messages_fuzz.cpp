@@ -9,20 +9,16 @@
 #include <cstdlib>
 #include <vector>
 
-#include "msgraphs/base/byte_order.hpp"
-#include "msgraphs/base/crc32.hpp"
 #include "msgraphs/core/collab/distilled_codec.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
+#include "sealed_message.hpp"
 
 using namespace msgraphs;
 using namespace msgraphs::core;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  std::vector<std::uint8_t> message(data + 1, data + size);
-  message.resize(message.size() + 4);
-  WriteU32Le(message.data() + message.size() - 4,
-             Crc32(std::span(message.data(), message.size() - 4)));
+  const std::vector<std::uint8_t> message = SealedMessage(std::span(data + 1, size - 1));
   const std::span<const std::uint8_t> bytes(message);
   switch (data[0] % 4) {
     case 0: {

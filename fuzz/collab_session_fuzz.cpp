@@ -9,9 +9,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "msgraphs/base/byte_order.hpp"
-#include "msgraphs/base/crc32.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
+#include "sealed_message.hpp"
 
 using namespace msgraphs;
 using namespace msgraphs::core;
@@ -46,10 +45,7 @@ CollabSession& Session() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  std::vector<std::uint8_t> message(data + 1, data + size);
-  message.resize(message.size() + 4);
-  WriteU32Le(message.data() + message.size() - 4,
-             Crc32(std::span(message.data(), message.size() - 4)));
+  const std::vector<std::uint8_t> message = SealedMessage(std::span(data + 1, size - 1));
   CollabSession& session = Session();
   NullOutbox out;
   static_cast<void>(

@@ -92,6 +92,22 @@ struct Walk {
   }
 };
 
+// Keyframe i of the walk, guessed from the previous estimate and the odometry, joined to the
+// previous keyframe by the odometry factor; its id goes to the back of `ids`.
+void AddWalkStep(SGraph& g, const Walk& walk, std::size_t i, std::vector<std::uint32_t>& ids) {
+  const Eigen::Isometry3d guess =
+      i == 0 ? walk.truth[0]
+             : g.keyframe_pose(ids.back()) * (walk.odometry[i - 1].inverse() * walk.odometry[i]);
+  auto id = g.AddKeyframe(static_cast<double>(i), guess);
+  ASSERT_TRUE(id);
+  if (i > 0) {
+    ASSERT_TRUE(g.AddRelativePose(ids.back(), *id,
+                                  walk.odometry[i - 1].inverse() * walk.odometry[i],
+                                  OdometryInformation(), RelativePoseKind::kOdometry));
+  }
+  ids.push_back(*id);
+}
+
 double MaxPositionError(const SGraph& g,
                         const std::vector<std::uint32_t>& ids,
                         const std::vector<Eigen::Isometry3d>& truth) {
@@ -115,17 +131,8 @@ TEST(SGraph, WallsRemoveOdometryDriftAndTheOriginStays) {
   std::vector<std::uint32_t> ids;
   std::vector<std::uint32_t> plane_ids;
   for (std::size_t i = 0; i < walk.truth.size(); ++i) {
-    const Eigen::Isometry3d guess =
-        i == 0 ? walk.truth[0]
-               : g.keyframe_pose(ids.back()) * (walk.odometry[i - 1].inverse() * walk.odometry[i]);
-    auto id = g.AddKeyframe(static_cast<double>(i), guess);
-    ASSERT_TRUE(id);
-    if (i > 0) {
-      ASSERT_TRUE(g.AddRelativePose(ids.back(), *id,
-                                    walk.odometry[i - 1].inverse() * walk.odometry[i],
-                                    OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-    ids.push_back(*id);
+    ASSERT_NO_FATAL_FAILURE(AddWalkStep(g, walk, i, ids));
+    const std::uint32_t id = ids.back();
     if (i == 0) {
       for (const TruePlane& w : walls)
         plane_ids.push_back(*g.AddPlane(w.n, w.d, PlaneClass::kWall));
@@ -133,10 +140,9 @@ TEST(SGraph, WallsRemoveOdometryDriftAndTheOriginStays) {
     }
     for (std::size_t w = 0; w < walls.size(); ++w) {
       ASSERT_TRUE(
-          g.AddPlaneObservation(*id, plane_ids[w], Measure(walls[w], walk.truth[i], rng, 0.005)));
+          g.AddPlaneObservation(id, plane_ids[w], Measure(walls[w], walk.truth[i], rng, 0.005)));
     }
-    ASSERT_TRUE(
-        g.AddPlaneObservation(*id, plane_ids[4], Measure(floor, walk.truth[i], rng, 0.005)));
+    ASSERT_TRUE(g.AddPlaneObservation(id, plane_ids[4], Measure(floor, walk.truth[i], rng, 0.005)));
     ASSERT_TRUE(g.Solve(SolveKind::kLocal));
   }
   // Odometry alone drifts by decimetres; the walls hold the estimate to centimetres.
@@ -172,24 +178,15 @@ TEST(SGraph, PlaneMarginalsAndExternalPriors) {
   std::mt19937 rng(5);
   std::vector<std::uint32_t> ids, plane_ids;
   for (std::size_t i = 0; i < walk.truth.size(); ++i) {
-    const Eigen::Isometry3d guess =
-        i == 0 ? walk.truth[0]
-               : g.keyframe_pose(ids.back()) * (walk.odometry[i - 1].inverse() * walk.odometry[i]);
-    auto id = g.AddKeyframe(static_cast<double>(i), guess);
-    ASSERT_TRUE(id);
-    if (i > 0) {
-      ASSERT_TRUE(g.AddRelativePose(ids.back(), *id,
-                                    walk.odometry[i - 1].inverse() * walk.odometry[i],
-                                    OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-    ids.push_back(*id);
+    ASSERT_NO_FATAL_FAILURE(AddWalkStep(g, walk, i, ids));
+    const std::uint32_t id = ids.back();
     if (i == 0) {
       for (const TruePlane& w : walls)
         plane_ids.push_back(*g.AddPlane(w.n, w.d, PlaneClass::kWall));
     }
     for (std::size_t w = 0; w < walls.size(); ++w)
       ASSERT_TRUE(
-          g.AddPlaneObservation(*id, plane_ids[w], Measure(walls[w], walk.truth[i], rng, 0.005)));
+          g.AddPlaneObservation(id, plane_ids[w], Measure(walls[w], walk.truth[i], rng, 0.005)));
     ASSERT_TRUE(g.Solve(SolveKind::kLocal));  // leaves the older nodes constant
   }
   std::vector<Eigen::Matrix3d> marginals(plane_ids.size());

@@ -264,7 +264,7 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
   m.sent_version = 0;
   m.calls = 0;
   const ScanContextConfig& sc = config.descriptor.scan_context;
-  m.descriptor_bytes = 21 + static_cast<std::size_t>(sc.rings * sc.sectors) + 4;
+  m.descriptor_bytes = RoomDescriptorEncodedSize(sc.rings, sc.sectors);
   std::size_t bytes = 0;
   m.own = std::vector<Impl::OwnRoom>(config.max_rooms);
   for (Impl::OwnRoom& r : m.own) r.cloud.Init(config.max_room_points);
@@ -389,8 +389,9 @@ Status CollabSession::Receive(CollabMessageType type,
   };
   switch (type) {
     case CollabMessageType::kDistilledGraph: {
-      if (bytes.size() < 8) return malformed(nullptr, {Errc::kMalformed, "distilled graph: short"});
-      const std::uint16_t robot = static_cast<std::uint16_t>(bytes[6] | (bytes[7] << 8));
+      auto sender = DistilledSender(bytes);
+      if (!sender) return malformed(nullptr, sender.error());
+      const std::uint16_t robot = *sender;
       if (robot == 0 || robot == m.config.robot)
         return malformed(nullptr, {Errc::kMalformed, "distilled graph: robot id is 0 or ours"});
       Impl::Peer* p = m.FindOrAddPeer(robot);
@@ -677,21 +678,18 @@ void CollabSession::Impl::Solve() {
   }
   // Everything else each merged robot mapped is attached too (one factor each: it does not move
   // the estimate, but the graph then holds every robot's walls and rooms in this frame).
+  auto attach = [&](std::uint16_t robot, const DistilledGraph& g, double floor) {
+    for (const DistilledWall& w : g.walls) stats.graph_refused += graph.AddWall(robot, w) ? 0u : 1u;
+    for (const DistilledRoom& r : g.rooms)
+      stats.graph_refused += graph.AddRoom(robot, r, floor) ? 0u : 1u;
+  };
+  bool any_merged = false;
   for (Peer& p : peers) {
     if (!p.used || p.consistent_count == 0 || !graph.has_robot(p.robot)) continue;
-    for (const DistilledWall& w : mine.walls)
-      stats.graph_refused += graph.AddWall(config.robot, w) ? 0u : 1u;
-    for (const DistilledRoom& r : mine.rooms)
-      stats.graph_refused += graph.AddRoom(config.robot, r, floor_z_m) ? 0u : 1u;
-    break;
+    attach(p.robot, p.graph, PeerFloor(p));
+    any_merged = true;
   }
-  for (Peer& p : peers) {
-    if (!p.used || p.consistent_count == 0 || !graph.has_robot(p.robot)) continue;
-    for (const DistilledWall& w : p.graph.walls)
-      stats.graph_refused += graph.AddWall(p.robot, w) ? 0u : 1u;
-    for (const DistilledRoom& r : p.graph.rooms)
-      stats.graph_refused += graph.AddRoom(p.robot, r, PeerFloor(p)) ? 0u : 1u;
-  }
+  if (any_merged) attach(config.robot, mine, floor_z_m);
   ++stats.solves;
   if (!graph.Solve()) ++stats.solve_failures;
   solved_version = distiller.graph().version;

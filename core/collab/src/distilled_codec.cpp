@@ -140,6 +140,13 @@ Expected<std::size_t> EncodeDistilled(const DistilledGraph& g,
   return w.pos();
 }
 
+Expected<std::uint16_t> DistilledSender(std::span<const std::uint8_t> bytes) {
+  constexpr std::size_t kRobotAt = 6;  // magic (4), format, flags
+  if (bytes.size() < kDistilledHeaderBytes)
+    return Error{Errc::kMalformed, "distilled graph: shorter than its header"};
+  return ReadU16Le(&bytes[kRobotAt]);
+}
+
 Expected<DistilledDelta> DecodeDistilled(std::span<const std::uint8_t> bytes,
                                          DistilledGraph& out,
                                          const DistilledGraph* known) {

@@ -42,7 +42,11 @@ Status CheckCrc(std::span<const std::uint8_t> bytes, std::size_t header) {
 }  // namespace
 
 std::size_t RoomDescriptorEncodedSize(const ScanContext& d) {
-  return kDescriptorHeader + static_cast<std::size_t>(d.rings() * d.sectors()) + 4;
+  return RoomDescriptorEncodedSize(d.rings(), d.sectors());
+}
+
+std::size_t RoomDescriptorEncodedSize(int rings, int sectors) {
+  return kDescriptorHeader + static_cast<std::size_t>(rings * sectors) + 4;
 }
 
 Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& h,

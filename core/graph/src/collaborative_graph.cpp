@@ -6,6 +6,8 @@
 #include <cmath>
 #include <vector>
 
+#include "s_graph_factors.hpp"
+
 namespace msgraphs::core {
 namespace {
 
@@ -15,26 +17,8 @@ Eigen::Matrix<T, 3, 3> Rotation(const T* q) {
   return Eigen::Quaternion<T>(q[3], q[0], q[1], q[2]).toRotationMatrix();
 }
 
-// A wall node (n, d in self's frame) against what its robot measured (n_m, d_m in the robot's
-// frame): the node expressed in the robot's frame, in the measurement's tangent coordinates
-// (u.n, v.n, delta d), whitened by the measurement's square-root information.
-struct WallMeasured {
-  Eigen::Vector3d u, v;
-  double d_m;
-  Eigen::Matrix3d sqrt_information;
-  template <typename T>
-  bool operator()(const T* q, const T* t, const T* n, const T* d, T* r) const {
-    const Eigen::Matrix<T, 3, 3> R = Rotation(q);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> n_self(n), t_self(t);
-    const Eigen::Matrix<T, 3, 1> n_robot = R.transpose() * n_self;
-    // n.p + d = 0 with p = R p_r + t: (R^T n).p_r + (d + n.t) = 0.
-    const T d_robot = d[0] + n_self.dot(t_self);
-    Eigen::Matrix<T, 3, 1> e(u.cast<T>().dot(n_robot), v.cast<T>().dot(n_robot), d_robot - T(d_m));
-    Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(r);
-    residual = sqrt_information.cast<T>() * e;
-    return true;
-  }
-};
+// A wall node (n, d in self's frame) against what its robot measured: the S-Graph's
+// keyframe-to-plane factor (sgraph::PlaneResidual) with the robot's origin as the "keyframe".
 
 struct WallSame {
   double inv_sigma_rad, inv_sigma_m;
@@ -289,8 +273,8 @@ Expected<std::uint32_t> CollaborativeGraph::AddWall(std::uint16_t robot, const D
   WallBasis(w.normal, u, v);
   const Eigen::Matrix3d sqrt_information = llt.matrixU();
   m.problem->AddParameterBlock(node.n, 3, &m.sphere_manifold);
-  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<WallMeasured, 3, 4, 3, 3, 1>(
-                                  new WallMeasured{u, v, w.d, sqrt_information}),
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<sgraph::PlaneResidual, 3, 4, 3, 3, 1>(
+                                  new sgraph::PlaneResidual{u, v, w.d, sqrt_information}),
                               m.huber.get(), o->q, o->t, node.n, &node.d);
   ++o->factors;
   ++m.factors;

@@ -50,6 +50,10 @@ Expected<DistilledDelta> DecodeDistilled(std::span<const std::uint8_t> bytes,
                                          DistilledGraph& out,
                                          const DistilledGraph* known = nullptr);
 
+/// The sending robot's id from a message's header (before decoding it against that robot's
+/// copy); kMalformed when the bytes are too short to hold a header.
+Expected<std::uint16_t> DistilledSender(std::span<const std::uint8_t> bytes);
+
 /// Merges a decoded delta into the receiver's copy (upsert by id). kCapacityExceeded (what fit
 /// is kept) when the copy is full.
 Status ApplyDistilled(const DistilledGraph& delta, DistilledGraph& copy);

@@ -30,6 +30,7 @@ struct RoomDescriptorHeader {
 };
 
 std::size_t RoomDescriptorEncodedSize(const ScanContext& descriptor);
+std::size_t RoomDescriptorEncodedSize(int rings, int sectors);
 Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& header,
                                            const ScanContext& descriptor,
                                            std::span<std::uint8_t> out);
