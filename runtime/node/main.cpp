@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: MIT
-// msgraphs_node: one process per robot. Today it has two modes: --self-check and --heartbeat;
-// the SLAM pipeline arrives with the onboard runtime issue.
+// msgraphs_node: one process per robot (docs/runtime.md).
+//
+//   msgraphs_node --config FILE [--set section.key=value]... [--check-config]
+//   msgraphs_node --self-check [--domain N]
+//   msgraphs_node --heartbeat --robot-id N [--domain N] [--loopback] [--peer IPv4]...
+//                 [--expect-peers K] [--duration-s S] [--rate-hz R]
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "modes.hpp"
 #include "msgraphs/platform/fail_handler.hpp"
@@ -13,7 +18,8 @@ namespace {
 
 void Usage() {
   std::fputs(
-      "usage: msgraphs_node --self-check [--domain N]\n"
+      "usage: msgraphs_node --config FILE [--set section.key=value]... [--check-config]\n"
+      "       msgraphs_node --self-check [--domain N]\n"
       "       msgraphs_node --heartbeat --robot-id N [--domain N] [--loopback] [--peer IPv4]...\n"
       "                     [--expect-peers K] [--duration-s S] [--rate-hz R]\n",
       stderr);
@@ -31,8 +37,11 @@ bool ParseNumber(const char* text, double* out) {
 int main(int argc, char** argv) {
   msgraphs::platform::InstallStderrFailHandler();
   using msgraphs::runtime::HeartbeatModeOptions;
-  enum class Mode { kNone, kSelfCheck, kHeartbeat } mode = Mode::kNone;
+  enum class Mode { kNone, kNode, kSelfCheck, kHeartbeat } mode = Mode::kNone;
   HeartbeatModeOptions options;
+  std::string config_path;
+  std::vector<std::string> overrides;
+  bool check_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
@@ -44,7 +53,14 @@ int main(int argc, char** argv) {
       }
       return number;
     };
-    if (arg == "--self-check") {
+    if (arg == "--config" && has_value) {
+      mode = Mode::kNode;
+      config_path = argv[++i];
+    } else if (arg == "--set" && has_value) {
+      overrides.emplace_back(argv[++i]);
+    } else if (arg == "--check-config") {
+      check_only = true;
+    } else if (arg == "--self-check") {
       mode = Mode::kSelfCheck;
     } else if (arg == "--heartbeat") {
       mode = Mode::kHeartbeat;
@@ -72,14 +88,18 @@ int main(int argc, char** argv) {
     }
   }
   switch (mode) {
-    case Mode::kSelfCheck: return msgraphs::runtime::RunSelfCheck(options.dds.domain_id);
+    case Mode::kNode:
+      return msgraphs::runtime::RunNode(config_path, overrides, check_only);
+    case Mode::kSelfCheck:
+      return msgraphs::runtime::RunSelfCheck(options.dds.domain_id);
     case Mode::kHeartbeat:
       if (!options.robot_id.valid()) {
         std::fputs("msgraphs_node: --heartbeat needs --robot-id (1..65535)\n", stderr);
         return 2;
       }
       return msgraphs::runtime::RunHeartbeatMode(options);
-    case Mode::kNone: break;
+    case Mode::kNone:
+      break;
   }
   Usage();
   return 2;

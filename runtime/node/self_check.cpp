@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <vector>
 
 #include "build_info.hpp"
 #include "modes.hpp"
+#include "msgraphs/core/collab/room_messages.hpp"
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/realtime.hpp"
-#include "msgraphs/runtime/link/heartbeat_link.hpp"
+#include "msgraphs/runtime/link/fleet_link.hpp"
 
 namespace msgraphs::runtime {
 
@@ -50,13 +52,13 @@ int RunSelfCheck(std::uint32_t domain_id) {
   PrintBanner(RobotId{});
   std::printf("\nself-check: Fast DDS exchange between two participants on 127.0.0.1 (domain %u)\n",
               domain_id);
-  link::DdsSettings settings;
-  settings.domain_id = domain_id;
-  settings.loopback_only = true;
+  link::LinkSettings settings;
+  settings.dds.domain_id = domain_id;
+  settings.dds.loopback_only = true;
 
   const SteadyTime t_start = platform::SteadyNow();
-  auto a = link::HeartbeatLink::Create(RobotId{1}, settings, BuildLabel());
-  auto b = link::HeartbeatLink::Create(RobotId{2}, settings, BuildLabel());
+  auto a = link::FleetLink::Create(RobotId{1}, settings);
+  auto b = link::FleetLink::Create(RobotId{2}, settings);
   if (!a || !b) {
     const Error& e = !a ? a.error() : b.error();
     std::printf("  FAILED: %s: %s\n", ToString(e.code), e.detail);
@@ -73,29 +75,35 @@ int RunSelfCheck(std::uint32_t domain_id) {
     std::printf("  FAILED: participants did not discover each other within 5 s\n");
     return 1;
   }
-  std::printf("  discovery           %.1f ms (both writers matched)\n", discovery.seconds() * 1e3);
+  std::printf("  discovery           %.1f ms (both telemetry writers matched)\n",
+              discovery.seconds() * 1e3);
 
+  // Room cloud requests robot 1 -> robot 2: the collab path, addressed, through every check.
   constexpr int kMessages = 50;
   std::vector<double> latency_us;
   int lost = 0;
+  std::array<std::uint8_t, core::kRoomCloudRequestBytes> request{};
+  link::InboundMessage received;
   for (int i = 0; i < kMessages; ++i) {
-    if (Status s = (*a)->Publish(platform::UnixNow(), platform::SteadyNow() - t_start); !s) {
-      std::printf("  FAILED: publish: %s\n", s.error().detail);
-      return 1;
-    }
-    auto got = (*b)->Receive(Duration::FromMilliseconds(1000));
-    if (!got) {
+    static_cast<void>(
+        core::EncodeRoomCloudRequest({1, 2, static_cast<std::uint32_t>(i), 1}, request));
+    const SteadyTime sent = platform::SteadyNow();
+    (*a)->Send(core::CollabMessageType::kRoomCloudRequest, 2, request);
+    if (!(*b)->Receive(received, Duration::FromMilliseconds(1000)) ||
+        received.bytes.size() != request.size() ||
+        !std::equal(received.bytes.begin(), received.bytes.end(), request.begin())) {
       ++lost;
       continue;
     }
-    latency_us.push_back(static_cast<double>((platform::UnixNow() - got->stamp).nanoseconds()) * 1e-3);
+    latency_us.push_back((platform::SteadyNow() - sent).seconds() * 1e6);
   }
-  std::printf("  heartbeats robot 1 -> robot 2: %d sent, %zu received, %d lost\n", kMessages,
-              latency_us.size(), lost);
+  std::printf("  room cloud requests robot 1 -> robot 2: %d sent, %zu received intact, %d lost\n",
+              kMessages, latency_us.size(), lost);
   std::printf("  latency             p50 %.0f us, p95 %.0f us, max %.0f us\n",
-              Percentile(latency_us, 0.5), Percentile(latency_us, 0.95), Percentile(latency_us, 1.0));
+              Percentile(latency_us, 0.5), Percentile(latency_us, 0.95),
+              Percentile(latency_us, 1.0));
   if (lost != 0) {
-    std::printf("self-check FAILED: heartbeats lost on a reliable loopback link\n");
+    std::printf("self-check FAILED: messages lost on a reliable loopback link\n");
     return 1;
   }
   std::printf("self-check passed\n");

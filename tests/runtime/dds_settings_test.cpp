@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "msgraphs/runtime/link/heartbeat_link.hpp"
+#include "msgraphs/runtime/link/fleet_link.hpp"
 
 namespace msgraphs::runtime::link {
 namespace {
@@ -25,8 +25,8 @@ TEST(DdsSettings, RejectsBadDomainAndPeers) {
   EXPECT_FALSE(Validate(s));
 }
 
-TEST(HeartbeatLink, RefusesReservedRobotIdWithoutTouchingTheNetwork) {
-  auto link = HeartbeatLink::Create(RobotId{0}, DdsSettings{}, "test");
+TEST(FleetLink, RefusesReservedRobotIdWithoutTouchingTheNetwork) {
+  auto link = FleetLink::Create(RobotId{0}, LinkSettings{});
   ASSERT_FALSE(link);
   EXPECT_EQ(link.error().code, Errc::kInvalidConfig);
 }

@@ -45,7 +45,7 @@
 #include "msgraphs/core/slam/local_mapper.hpp"
 #include "msgraphs/drivers/can_odometry/candump_file.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
-#include "msgraphs/tools/recorded_scans.hpp"
+#include "msgraphs/drivers/velodyne/recorded_scans.hpp"
 #include "msgraphs/tools/tum.hpp"
 
 namespace {
@@ -71,7 +71,7 @@ constexpr float kKeyframeScThreshold = 0.25f;   // keyframe candidates (tighter:
 struct Robot {
   int index = 0;  // 0-based; robot ids on the wire are index + 1
   std::uint16_t id() const { return static_cast<std::uint16_t>(index + 1); }
-  std::unique_ptr<tools::RecordedScans> scans;
+  std::unique_ptr<drivers::velodyne::RecordedScans> scans;
   std::optional<drivers::can_odometry::CandumpFileReader> candump;
   drivers::can_odometry::OdometryStream odometry =
       drivers::can_odometry::OdometryStream::Create({}).value();
@@ -416,7 +416,7 @@ int main(int argc, char** argv) {
     if (!fs::exists(dir / "velodyne.pcap")) break;
     auto r = std::make_unique<Robot>();
     r->index = i;
-    r->scans = tools::RecordedScans::Open((dir / "velodyne.pcap").string());
+    r->scans = drivers::velodyne::RecordedScans::Open((dir / "velodyne.pcap").string());
     auto candump = drivers::can_odometry::CandumpFileReader::Open((dir / "odometry.log").c_str());
     if (!r->scans || !candump) {
       std::fprintf(stderr, "collab: cannot open %s\n", dir.c_str());

@@ -32,7 +32,7 @@
 #include "msgraphs/drivers/velodyne/data_packet_decoder.hpp"
 #include "msgraphs/drivers/velodyne/device_clock.hpp"
 #include "msgraphs/drivers/velodyne/scan_assembler.hpp"
-#include "msgraphs/tools/recorded_scans.hpp"
+#include "msgraphs/drivers/velodyne/recorded_scans.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
 #include "world.hpp"
@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
     const fs::path dir = fs::path(run) / ("robot" + std::to_string(robot));
     if (!fs::exists(dir / "velodyne.pcap")) break;
     const auto tum = tools::ReadTum((dir / "ground_truth.tum").string());
-    auto scans = tools::RecordedScans::Open((dir / "velodyne.pcap").string());
+    auto scans = drivers::velodyne::RecordedScans::Open((dir / "velodyne.pcap").string());
     if (!scans) return 1;
     Eigen::Isometry3d last_keyframe = Eigen::Isometry3d::Identity();
     bool have_keyframe = false;

@@ -24,7 +24,7 @@
 #include "msgraphs/core/slam/local_mapper.hpp"
 #include "msgraphs/drivers/can_odometry/candump_file.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
-#include "msgraphs/tools/recorded_scans.hpp"
+#include "msgraphs/drivers/velodyne/recorded_scans.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
 #include "world.hpp"
@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
   }
   rusage after_init{};
   getrusage(RUSAGE_SELF, &after_init);
-  auto scans = tools::RecordedScans::Open((dir / "velodyne.pcap").string());
+  auto scans = drivers::velodyne::RecordedScans::Open((dir / "velodyne.pcap").string());
   auto candump = drivers::can_odometry::CandumpFileReader::Open((dir / "odometry.log").c_str());
   if (!scans || !candump) {
     std::fprintf(stderr, "slam: cannot open the recording in %s\n", dir.c_str());

@@ -106,6 +106,22 @@ Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t
   return h;
 }
 
+Expected<RoomDescriptorHeader> PeekRoomDescriptorHeader(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < kDescriptorHeader || !MagicIs(bytes, "MSRD"))
+    return Error{Errc::kMalformed, "room descriptor: not a descriptor header"};
+  return RoomDescriptorHeader{ReadU16Le(&bytes[5]), ReadU32Le(&bytes[7]), ReadU32Le(&bytes[11])};
+}
+
+Expected<RoomCloudHeader> PeekRoomCloudHeader(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < kCloudHeader || !MagicIs(bytes, "MSRC"))
+    return Error{Errc::kMalformed, "room cloud: not a cloud header"};
+  RoomCloudHeader h;
+  h.robot = ReadU16Le(&bytes[6]);
+  h.room = ReadU32Le(&bytes[8]);
+  h.version = ReadU32Le(&bytes[12]);
+  return h;
+}
+
 std::size_t RoomCloudEncodedSize(CloudEncoding encoding, std::size_t points) {
   const std::size_t per_point = encoding == CloudEncoding::kFloat32       ? 12u
                                 : encoding == CloudEncoding::kQuantised16 ? 6u

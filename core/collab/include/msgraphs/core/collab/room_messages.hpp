@@ -36,6 +36,10 @@ Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& header,
                                            std::span<std::uint8_t> out);
 Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t> bytes,
                                                     ScanContext& descriptor);
+/// The header fields only, unchecked (no CRC, no body): for a transport that files the message
+/// under its robot and room before the receiver decodes it. kMalformed when too short or the
+/// magic is wrong.
+Expected<RoomDescriptorHeader> PeekRoomDescriptorHeader(std::span<const std::uint8_t> bytes);
 
 /// kQuantised8: 3 bytes a point, +-127 steps (+-6.35 m at 5 cm: a room cloud in its room frame,
 /// cropped to the walls plus 0.3 m, fits unless the room is wider than 12 m).
@@ -55,6 +59,8 @@ Expected<std::size_t> EncodeRoomCloud(const RoomCloudHeader& header,
                                       std::span<std::uint8_t> out);
 Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
                                           BoundedVector<Eigen::Vector3f>& points);
+/// Robot, room and version of a cloud message, unchecked (see PeekRoomDescriptorHeader).
+Expected<RoomCloudHeader> PeekRoomCloudHeader(std::span<const std::uint8_t> bytes);
 
 struct RoomCloudRequest {
   std::uint16_t from = 0, to = 0;

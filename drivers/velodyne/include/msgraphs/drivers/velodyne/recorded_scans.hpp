@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The complete VLP-16 sweeps of a recorded pcap, through the real drivers (UDP extraction,
-// decoding, device clock, scan assembly), for the host tools that evaluate on recordings.
+// decoding, device clock, scan assembly): the node's recorded LiDAR input and the host tools'.
 #pragma once
 
 #include <memory>
@@ -13,22 +13,22 @@
 #include "msgraphs/drivers/velodyne/device_clock.hpp"
 #include "msgraphs/drivers/velodyne/scan_assembler.hpp"
 
-namespace msgraphs::tools {
+namespace msgraphs::drivers::velodyne {
 
 class RecordedScans {
  public:
   /// nullptr when the file cannot be opened or is not a pcap.
   static std::unique_ptr<RecordedScans> Open(const std::string& pcap_path) {
-    auto reader = drivers::pcap::PcapFileReader::Open(pcap_path.c_str());
+    auto reader = pcap::PcapFileReader::Open(pcap_path.c_str());
     if (!reader) return nullptr;
     return std::unique_ptr<RecordedScans>(new RecordedScans(std::move(*reader)));
   }
 
   /// The next complete sweep, or nullptr at the end of the file (incomplete sweeps are skipped).
-  const drivers::velodyne::Scan* Next() {
+  const Scan* Next() {
     while (reader_.Next(record_).value_or(false)) {
-      auto d = drivers::pcap::ExtractUdp(reader_.header(), record_, counters_);
-      if (!d || d->payload.size() != drivers::velodyne::kDataPacketBytes) continue;
+      auto d = pcap::ExtractUdp(reader_.header(), record_, counters_);
+      if (!d || d->payload.size() != kDataPacketBytes) continue;
       auto decoded = decoder_.Decode(d->payload, packet_);
       if (!decoded) continue;
       const UnixTime first =
@@ -41,19 +41,19 @@ class RecordedScans {
   }
 
  private:
-  explicit RecordedScans(drivers::pcap::PcapFileReader reader)
+  explicit RecordedScans(pcap::PcapFileReader reader)
       : reader_(std::move(reader)),
-        decoder_(drivers::velodyne::DataPacketDecoder::Create({}).value()),
-        assembler_(drivers::velodyne::ScanAssembler::Create({}).value()),
-        packet_(drivers::velodyne::kMaxPointsPerPacket) {}
+        decoder_(DataPacketDecoder::Create({}).value()),
+        assembler_(ScanAssembler::Create({}).value()),
+        packet_(kMaxPointsPerPacket) {}
 
-  drivers::pcap::PcapFileReader reader_;
-  drivers::velodyne::DataPacketDecoder decoder_;
-  drivers::velodyne::ScanAssembler assembler_;
-  drivers::velodyne::DeviceClockSync sync_;
-  std::vector<drivers::velodyne::VelodynePoint> packet_;
-  drivers::pcap::PcapRecord record_;
-  drivers::pcap::PcapUdpCounters counters_;
+  pcap::PcapFileReader reader_;
+  DataPacketDecoder decoder_;
+  ScanAssembler assembler_;
+  DeviceClockSync sync_;
+  std::vector<VelodynePoint> packet_;
+  pcap::PcapRecord record_;
+  pcap::PcapUdpCounters counters_;
 };
 
-}  // namespace msgraphs::tools
+}  // namespace msgraphs::drivers::velodyne

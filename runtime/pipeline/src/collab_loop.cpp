@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// The collab thread: messages from the link into the session, room matching, and the two
+// recovery paths of the link:
+// - a robot we hear whose graph we lack or hold behind for a while (we joined late, a delta
+//   was lost, the link was cut) is put on our resync list, which our telemetry carries;
+// - a robot whose telemetry lists us gets everything again (ResendAll, published by the SLAM
+//   thread at once).
+#include <algorithm>
+#include <map>
+
+#include "msgraphs/platform/clock.hpp"
+#include "msgraphs/platform/realtime.hpp"
+#include "node_impl.hpp"
+
+namespace msgraphs::runtime {
+
+namespace {
+
+constexpr Duration kReceiveWait = Duration::FromMilliseconds(100);
+constexpr std::size_t kMessagesPerRound = 64;  ///< then Match runs, even under a flood
+/// A peer's graph held behind what its telemetry announces for this long: ask for all of it.
+constexpr Duration kBehindPatience = Duration::FromSeconds(3.0);
+/// At most one ResendAll per this interval, however many robots ask.
+constexpr Duration kResendInterval = Duration::FromSeconds(2.0);
+
+}  // namespace
+
+void Node::Impl::CollabLoop() {
+  static_cast<void>(platform::SetCurrentThreadName("msg-collab"));
+  link::InboundMessage message;
+  message.bytes.reserve(
+      link::kMaxPayloadBytes[static_cast<std::size_t>(core::CollabMessageType::kRoomCloud)]);
+  std::map<std::uint16_t, SteadyTime> behind_since;
+  std::map<std::uint16_t, std::uint64_t> gaps_seen;
+  SteadyTime last_resend;
+  bool resent_once = false;
+
+  while (!ShouldStop()) {
+    std::size_t received = 0;
+    bool changed = false;
+    if (link->Receive(message, kReceiveWait)) {
+      std::lock_guard<std::mutex> lock(session_mutex);
+      do {
+        // Malformed messages are counted by the session (per peer) and dropped here.
+        if (session.Receive(message.type, message.bytes, *link)) changed = true;
+        ++received;
+      } while (received < kMessagesPerRound && link->Receive(message, Duration()));
+    }
+    bool origins_changed = false;
+    {
+      std::lock_guard<std::mutex> lock(session_mutex);
+      origins_changed = session.Match(*link);
+      if ((changed || origins_changed) && config.feedback) {
+        // The priors are recomputed whenever a peer's walls or an origin moved; the SLAM
+        // thread takes the newest at its next exchange.
+        const std::size_t n = session.PlanePriors(std::span(priors_scratch_collab));
+        std::lock_guard<std::mutex> priors_lock(priors_mutex);
+        std::copy_n(priors_scratch_collab.begin(), n, priors_mailbox.begin());
+        priors_count = n;
+        ++priors_generation;
+      }
+    }
+    if (changed || origins_changed) collab_changes.fetch_add(1, std::memory_order_relaxed);
+
+    // Recovery, from what the other robots' telemetry says.
+    const SteadyTime now = platform::SteadyNow();
+    std::vector<std::uint16_t> want;
+    bool asked_for_us = false;
+    for (const link::FleetLink::PeerView& peer : link->Peers()) {
+      const std::uint16_t robot = peer.telemetry.robot.value;
+      if (!peer.alive || robot == 0) continue;
+      for (std::uint16_t r : peer.telemetry.resync_from) asked_for_us |= r == config.robot.value;
+      if (peer.telemetry.graph_version == 0) continue;
+      std::uint32_t held = 0;
+      std::uint64_t gaps = 0;
+      {
+        std::lock_guard<std::mutex> lock(session_mutex);
+        for (std::size_t i = 0; i < session.peers(); ++i) {
+          const core::CollabPeerStats s = session.peer_stats(i);
+          if (s.robot != robot) continue;
+          held = s.graph_version;
+          gaps = s.graph_gaps;
+        }
+      }
+      const bool gap = gaps != gaps_seen[robot];
+      gaps_seen[robot] = gaps;
+      if (held >= peer.telemetry.graph_version && !gap) {
+        behind_since.erase(robot);
+        continue;
+      }
+      auto [it, fresh] = behind_since.try_emplace(robot, now);
+      if (gap || now - it->second >= kBehindPatience) want.push_back(robot);
+    }
+    {
+      std::lock_guard<std::mutex> lock(resync_mutex);
+      if (want != resync_from && !want.empty())
+        resyncs_requested.fetch_add(1, std::memory_order_relaxed);
+      resync_from = want;
+    }
+    if (asked_for_us && (!resent_once || now - last_resend >= kResendInterval)) {
+      {
+        std::lock_guard<std::mutex> lock(session_mutex);
+        session.ResendAll();
+      }
+      resends.fetch_add(1, std::memory_order_relaxed);
+      last_resend = now;
+      resent_once = true;
+      publish_now = true;
+      wake_slam.notify_one();
+    }
+  }
+}
+
+}  // namespace msgraphs::runtime

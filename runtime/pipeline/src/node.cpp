@@ -1,0 +1,299 @@
+// SPDX-License-Identifier: MIT
+// Node construction and the supervisor: telemetry, status lines, the status LED and the exit
+// conditions, on the caller's thread.
+#include <cinttypes>
+#include <cstdio>
+
+#include "msgraphs/drivers/gpio/gpio.hpp"
+#include "msgraphs/platform/clock.hpp"
+#include "msgraphs/platform/realtime.hpp"
+#include "node_impl.hpp"
+
+namespace msgraphs::runtime {
+
+namespace {
+
+constexpr Duration kSupervisorTick =
+    Duration::FromMilliseconds(50);  // the LED's blink needs ~10 Hz
+
+const char* PaceName(const config::NodeConfig& c) {
+  if (c.lidar_source == config::LidarSource::kUdp) return "live";
+  return c.pace == config::Pace::kLockstep ? "recorded, lock-step" : "recorded pace";
+}
+
+}  // namespace
+
+Node::Node(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Node::~Node() {
+  if (!impl_) return;
+  impl_->stopping = true;
+  impl_->scans.Close();
+  impl_->odometry.Close();
+  impl_->wake_slam.notify_all();
+  for (std::thread& t : impl_->threads)
+    if (t.joinable()) t.join();
+}
+
+std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
+                                   const std::string& build_label,
+                                   std::string& error) {
+  auto impl = std::make_unique<Impl>(config);
+  Impl& m = *impl;
+  m.build_label = build_label;
+  m.started = platform::SteadyNow();
+  auto fail = [&](const char* stage, const Error& e) {
+    error = std::string(stage) + ": " + ToString(e.code) + ": " + e.detail;
+    return nullptr;
+  };
+
+  // Every buffer is allocated here, before the threads start.
+  for (std::size_t i = 0; i < config.scan_queue; ++i) {
+    ScanSlot* slot = m.scans.BeginPush(Duration(), false);
+    slot->points.reserve(config.mapper.max_scan_points);
+    slot->time_offset_s.reserve(config.mapper.max_scan_points);
+    m.scans.CommitPush();
+  }
+  for (std::size_t i = 0; i < config.scan_queue; ++i) m.scans.Pop();
+  if (Status s = m.mapper.Init(config.mapper); !s) return fail("local mapper", s.error());
+  if (Status s = m.session.Init(config.collab, config.mapper.graph, -config.mapper.base_height_m);
+      !s)
+    return fail("collab session", s.error());
+  m.priors_mailbox.resize(config.mapper.max_plane_priors);
+  m.priors_scratch.resize(config.mapper.max_plane_priors);
+  m.priors_scratch_collab.resize(config.mapper.max_plane_priors);
+  m.unpublished_keyframes.reserve(4096);
+  if (config.pace == config::Pace::kRecorded)
+    m.replay_clock = std::make_unique<ReplayClock>(config.speed);
+
+  auto link = link::FleetLink::Create(config.robot, config.link);
+  if (!link) return fail("DDS link", link.error());
+  m.link = std::move(*link);
+
+  if (!config.led_chip.empty()) {
+    m.gpio = drivers::gpio::MakeLibgpiodProvider();
+    drivers::gpio::GpioLineSpec spec;
+    spec.chip = config.led_chip;
+    spec.line = config.led_line;
+    spec.active_low = config.led_active_low;
+    auto line = m.gpio->OpenOutput(spec, "msgraphs_node", false);
+    if (line) {
+      m.led_line = std::move(*line);
+      m.led = std::make_unique<drivers::gpio::StatusLed>(*m.led_line);
+    } else {
+      // A missing LED must not keep the robot from mapping.
+      std::fprintf(stderr,
+                   "msgraphs_node: WARNING: status LED %s line %s: %s; running without it\n",
+                   config.led_chip.c_str(), config.led_line.c_str(), line.error().detail);
+    }
+  }
+  return std::unique_ptr<Node>(new Node(std::move(impl)));
+}
+
+link::Telemetry Node::Impl::MakeTelemetry() const {
+  link::Telemetry t;
+  t.stamp = platform::UnixNow();
+  t.uptime = platform::SteadyNow() - started;
+  t.build = build_label;
+  t.state = stopping ? link::NodeState::kStopping : state.load();
+  {
+    std::lock_guard<std::mutex> lock(status_mutex);
+    t.keyframes = static_cast<std::uint32_t>(slam_status.keyframes);
+    t.walls = slam_status.walls;
+    t.rooms = slam_status.rooms;
+    t.graph_version = slam_status.graph_version;
+  }
+  const link::LinkStats stats = link->stats();
+  for (const link::TopicStats& s : stats.topics) {
+    t.bytes_sent += s.sent_bytes;
+    t.bytes_received += s.received_bytes;
+  }
+  {
+    std::lock_guard<std::mutex> lock(session_mutex);
+    for (std::size_t i = 0; i < session.peers() && !t.merged.full(); ++i) {
+      const core::CollabPeerStats s = session.peer_stats(i);
+      if (s.merged) t.merged.push_back(s.robot);
+    }
+  }
+  {
+    std::lock_guard<std::mutex> lock(resync_mutex);
+    for (std::uint16_t r : resync_from)
+      if (!t.resync_from.full()) t.resync_from.push_back(r);
+  }
+  return t;
+}
+
+void Node::Impl::PrintStatus(double since_start_s) {
+  std::uint64_t& last_scans = status_last_scans;
+  std::uint64_t& last_odometry = status_last_odometry;
+  double& last_t = status_last_t;
+  const double dt = std::max(since_start_s - last_t, 1e-3);
+  const std::uint64_t scans_now = lidar_counters.items.load(),
+                      odometry_now = odometry_counters.items.load();
+  const auto sq = scans.stats(), oq = odometry.stats();
+  SlamStatus s;
+  {
+    std::lock_guard<std::mutex> lock(status_mutex);
+    s = slam_status;
+  }
+  const link::LinkStats ls = link->stats();
+  std::uint64_t sent = 0, rejected = 0;
+  for (const link::TopicStats& t : ls.topics) {
+    sent += t.sent_bytes;
+    rejected += t.rejected_version + t.rejected_sender + t.rejected_oversize + t.undecodable;
+  }
+  std::string peers;
+  std::uint64_t malformed = 0;
+  {
+    std::lock_guard<std::mutex> lock(session_mutex);
+    malformed = session.stats().malformed;
+    for (std::size_t i = 0; i < session.peers(); ++i) {
+      const core::CollabPeerStats p = session.peer_stats(i);
+      std::uint64_t in = 0;
+      for (std::uint64_t b : p.bytes_received) in += b;
+      char buffer[96];
+      std::snprintf(buffer, sizeof buffer, "%s r%u %s %.1f kB in", peers.empty() ? "" : ",",
+                    p.robot, p.merged ? "merged" : "not merged", static_cast<double>(in) / 1e3);
+      peers += buffer;
+    }
+  }
+  std::printf(
+      "[robot %u %7.1f s %-10s] lidar %.1f Hz (queue peak %zu/%zu, dropped %" PRIu64
+      ", bad %" PRIu64 ") | odometry %.0f Hz (peak %zu/%zu, dropped %" PRIu64 ", bad %" PRIu64
+      ") | map %" PRIu64
+      " keyframes (p50 %.0f ms, p99 %.0f ms), %u walls, %u rooms, %zu priors | link sent %.1f kB, "
+      "rejected %" PRIu64 ", malformed %" PRIu64 "; peers:%s\n",
+      config.robot.value, since_start_s, link::ToString(state.load()),
+      static_cast<double>(scans_now - last_scans) / dt, sq.peak, sq.capacity, sq.dropped,
+      lidar_counters.rejected.load(), static_cast<double>(odometry_now - last_odometry) / dt,
+      oq.peak, oq.capacity, oq.dropped, odometry_counters.rejected.load(), s.keyframes,
+      s.keyframe_p50_ms, s.keyframe_p99_ms, s.walls, s.rooms, s.plane_priors,
+      static_cast<double>(sent) / 1e3, rejected, malformed,
+      peers.empty() ? " none yet" : peers.c_str());
+  std::fflush(stdout);
+  last_scans = scans_now;
+  last_odometry = odometry_now;
+  last_t = since_start_s;
+}
+
+int Node::Run(const std::atomic<bool>& stop) {
+  Impl& m = *impl_;
+  m.stop = &stop;
+  const config::NodeConfig& c = m.config;
+  std::printf("%s\n  robot %u (%s): lidar %s, odometry %s, %s\n", m.build_label.c_str(),
+              c.robot.value, c.name.c_str(),
+              c.lidar_source == config::LidarSource::kPcap ? c.pcap_path.c_str() : "Velodyne UDP",
+              c.odometry_source == config::OdometrySource::kCandump ? c.candump_path.c_str()
+                                                                    : c.can_interface.c_str(),
+              PaceName(c));
+  std::printf("  DDS domain %u%s, discovery %s, radio cap %s, exchange every %.1f s\n",
+              c.link.dds.domain_id, c.link.dds.loopback_only ? " (127.0.0.1 only)" : "",
+              c.link.dds.discovery == link::Discovery::kMulticast ? "multicast"
+              : c.link.dds.discovery == link::Discovery::kUnicast ? "unicast peers"
+                                                                  : "Discovery Server",
+              c.link.max_bytes_per_s == 0
+                  ? "none"
+                  : (std::to_string(c.link.max_bytes_per_s / 1000) + " kB/s").c_str(),
+              c.exchange_period_s);
+  if (c.lock_memory) {
+    if (Status s = platform::LockProcessMemory(); s)
+      std::printf("  memory locked (mlockall)\n");
+    else
+      std::printf("  WARNING: memory NOT locked (%s): page faults may stall the sensor threads\n",
+                  s.error().detail);
+  }
+  if (c.realtime_priority > 0) {
+    const platform::RealtimeCapabilities caps = platform::ProbeRealtimeCapabilities();
+    if (caps.can_use_fifo)
+      std::printf("  sensor threads SCHED_FIFO priority %d\n", c.realtime_priority);
+    else
+      std::printf(
+          "  WARNING: SCHED_FIFO not permitted (needs CAP_SYS_NICE or an rtprio limit): "
+          "sensor threads run at normal priority\n");
+  }
+  std::fflush(stdout);
+
+  m.threads.emplace_back([&m] { m.LidarLoop(); });
+  m.threads.emplace_back([&m] { m.OdometryLoop(); });
+  m.threads.emplace_back([&m] { m.SlamLoop(); });
+  m.threads.emplace_back([&m] { m.CollabLoop(); });
+
+  int exit_code = 0;
+  const Duration telemetry_period = Duration::FromSeconds(1.0 / c.telemetry_hz);
+  const Duration status_period = Duration::FromSeconds(c.status_period_s);
+  SteadyTime next_telemetry = m.started, next_status = m.started + status_period;
+  std::uint64_t seen_changes = 0, seen_drops = 0;
+  SteadyTime last_change = m.started, done_since;
+  bool done_seen = false;
+  if (m.led) m.led->SetHealth(drivers::gpio::Health::kStarting, m.started);
+  while (!stop.load()) {
+    platform::SleepUntil(platform::SteadyNow() + kSupervisorTick);
+    const SteadyTime now = platform::SteadyNow();
+    if (m.lidar_counters.failed || m.odometry_counters.failed) {
+      InputCounters& failed = m.lidar_counters.failed ? m.lidar_counters : m.odometry_counters;
+      std::lock_guard<std::mutex> lock(failed.error_mutex);
+      std::fprintf(stderr, "msgraphs_node: input failed: %s\n", failed.error.c_str());
+      if (m.led) m.led->SetHealth(drivers::gpio::Health::kFault, now);
+      exit_code = 1;
+      break;
+    }
+    if (now >= next_telemetry) {
+      static_cast<void>(m.link->PublishTelemetry(m.MakeTelemetry()));
+      next_telemetry = next_telemetry + telemetry_period;
+      if (next_telemetry < now) next_telemetry = now + telemetry_period;
+    }
+    const std::uint64_t drops = m.scans.stats().dropped + m.odometry.stats().dropped;
+    if (m.led) {
+      using drivers::gpio::Health;
+      const Health health = m.state.load() == link::NodeState::kStarting ? Health::kStarting
+                            : drops != seen_drops                        ? Health::kDegraded
+                                                                         : Health::kOk;
+      if (health != m.led->health()) m.led->SetHealth(health, now);
+      m.led->Update(now);
+    }
+    if (now >= next_status) {
+      m.PrintStatus((now - m.started).seconds());
+      next_status = next_status + status_period;
+      seen_drops = drops;  // the LED shows degraded for one status period after a drop
+    }
+    if (c.max_run_s > 0 && (now - m.started).seconds() >= c.max_run_s) {
+      std::printf("robot %u: max_run_s reached\n", c.robot.value);
+      break;
+    }
+    // Exit once the recordings of this robot and of every robot heard have ended and nothing
+    // changed in the collaborative estimate for exit_after_done_s.
+    const std::uint64_t changes = m.collab_changes.load();
+    if (changes != seen_changes) {
+      seen_changes = changes;
+      last_change = now;
+    }
+    if (c.exit_after_done_s > 0 && m.state.load() == link::NodeState::kInputDone) {
+      if (!done_seen) {
+        done_seen = true;
+        done_since = now;
+      }
+      bool peers_done = true;
+      for (const auto& peer : m.link->Peers()) {
+        if (peer.alive && peer.telemetry.state != link::NodeState::kInputDone &&
+            peer.telemetry.state != link::NodeState::kStopping)
+          peers_done = false;
+      }
+      const Duration quiet = Duration::FromSeconds(c.exit_after_done_s);
+      if (peers_done && now - last_change >= quiet && now - done_since >= quiet) break;
+    }
+  }
+  m.stopping = true;
+  static_cast<void>(m.link->PublishTelemetry(m.MakeTelemetry()));  // state: stopping
+  m.scans.Close();
+  m.odometry.Close();
+  m.wake_slam.notify_all();
+  for (std::thread& t : m.threads) t.join();
+  m.threads.clear();
+  if (m.led) m.led->SetHealth(drivers::gpio::Health::kOff, platform::SteadyNow());
+  m.PrintStatus((platform::SteadyNow() - m.started).seconds());
+  m.WriteOutputs();
+  m.PrintReport();
+  return exit_code;
+}
+
+}  // namespace msgraphs::runtime

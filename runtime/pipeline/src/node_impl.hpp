@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: MIT
+// Node internals shared by its thread loops (one file per thread).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "msgraphs/core/collab/collab_session.hpp"
+#include "msgraphs/core/slam/local_mapper.hpp"
+#include "msgraphs/drivers/gpio/gpio.hpp"
+#include "msgraphs/drivers/gpio/status_led.hpp"
+#include "msgraphs/runtime/link/fleet_link.hpp"
+#include "msgraphs/runtime/pipeline/bounded_queue.hpp"
+#include "msgraphs/runtime/pipeline/node.hpp"
+#include "msgraphs/runtime/pipeline/replay_clock.hpp"
+
+namespace msgraphs::runtime {
+
+/// One assembled sweep, in the lidar frame, as the SLAM thread needs it.
+struct ScanSlot {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<float> time_offset_s;
+  double start_s = 0, end_s = 0;
+  std::uint64_t sequence = 0;
+  SteadyTime last_packet;  ///< when its last packet arrived (or was due, in replay)
+};
+
+struct OdometrySlot {
+  double stamp_s = 0;
+  Eigen::Isometry3d T_odom_base = Eigen::Isometry3d::Identity();
+};
+
+/// Latency samples in milliseconds, the newest `capacity` kept (allocated once).
+class LatencyWindow {
+ public:
+  explicit LatencyWindow(std::size_t capacity) : values_(capacity) {}
+  void Add(double ms);
+  /// p in [0, 1]; 0 when empty.
+  double Percentile(double p) const;
+  std::uint64_t count() const { return count_; }
+
+ private:
+  std::vector<double> values_;
+  std::uint64_t count_ = 0;
+};
+
+/// Counters a thread updates and the supervisor reads; relaxed atomics (statistics only).
+struct InputCounters {
+  std::atomic<std::uint64_t> items{0};     ///< scans or odometry samples delivered
+  std::atomic<std::uint64_t> rejected{0};  ///< malformed packets or frames
+  std::atomic<bool> done{false};           ///< the recording ended (never for live inputs)
+  std::atomic<bool> failed{false};
+  std::mutex error_mutex;
+  std::string error;
+  void Fail(const std::string& why) {
+    {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      error = why;
+    }
+    failed = true;
+  }
+};
+
+/// What the SLAM thread reports after each scan (under `mutex`).
+struct SlamStatus {
+  std::uint64_t scans = 0, keyframes = 0, no_odometry = 0;
+  std::uint32_t walls = 0, rooms = 0;
+  std::uint32_t graph_version = 0;  ///< the distilled version we have sent
+  double keyframe_p50_ms = 0, keyframe_p99_ms = 0;
+  double wire_p50_ms = 0, wire_p99_ms = 0, wire_max_ms = 0;  ///< last packet -> on the wire
+  std::uint64_t wire_samples = 0;
+  std::uint64_t publishes = 0;
+  std::size_t plane_priors = 0;
+};
+
+struct Node::Impl {
+  config::NodeConfig config;
+  std::string build_label;
+  SteadyTime started;
+  const std::atomic<bool>* stop = nullptr;
+  std::atomic<bool> stopping{false};
+  std::atomic<link::NodeState> state{link::NodeState::kStarting};
+
+  // Inputs and their queues.
+  BoundedQueue<ScanSlot> scans;
+  BoundedQueue<OdometrySlot> odometry;
+  InputCounters lidar_counters, odometry_counters;
+  std::unique_ptr<ReplayClock> replay_clock;
+  bool lockstep() const { return config.pace == config::Pace::kLockstep; }
+
+  // SLAM (owned by the SLAM thread once running).
+  core::LocalMapper mapper;
+  LatencyWindow keyframe_ms{4096}, wire_ms{4096};
+  std::vector<SteadyTime> unpublished_keyframes;  ///< last-packet times since the last Publish
+  mutable std::mutex status_mutex;
+  SlamStatus slam_status;
+
+  // The collaborative side: session under session_mutex (SLAM and collab threads).
+  mutable std::mutex session_mutex;
+  core::CollabSession session;
+  std::unique_ptr<link::FleetLink> link;
+  // Wall priors computed by the collab thread, applied by the SLAM thread at its next exchange.
+  std::mutex priors_mutex;
+  std::vector<core::PlanePrior> priors_mailbox, priors_scratch, priors_scratch_collab;
+  std::size_t priors_count = 0;
+  std::uint64_t priors_generation = 0;
+  std::uint64_t applied_priors_generation = 0;  ///< SLAM thread only
+  // Set by the collab thread when a peer asked for our whole graph; the SLAM thread publishes.
+  std::atomic<bool> publish_now{false};
+  std::mutex wake_mutex;
+  std::condition_variable wake_slam;
+  // Resync requests we make (robots whose whole graph we need), read by the supervisor.
+  mutable std::mutex resync_mutex;
+  std::vector<std::uint16_t> resync_from;
+  std::atomic<std::uint64_t> collab_changes{0};  ///< receptions that changed something, matches
+  std::atomic<std::uint64_t> resends{0}, resyncs_requested{0};
+
+  // Status LED (optional).
+  std::unique_ptr<drivers::gpio::GpioProvider> gpio;
+  std::unique_ptr<drivers::gpio::DigitalOutput> led_line;
+  std::unique_ptr<drivers::gpio::StatusLed> led;
+
+  std::vector<std::thread> threads;
+  // PrintStatus's previous counters (supervisor thread only), for rates.
+  std::uint64_t status_last_scans = 0, status_last_odometry = 0;
+  double status_last_t = 0;
+
+  Impl(const config::NodeConfig& c) : config(c), scans(c.scan_queue), odometry(c.odometry_queue) {}
+
+  bool ShouldStop() const { return stopping.load() || stop->load(); }
+
+  // Thread loops (inputs.cpp, slam_loop.cpp, collab_loop.cpp).
+  void LidarLoop();
+  void OdometryLoop();
+  void SlamLoop();
+  void CollabLoop();
+  // SLAM thread: Publish under the session lock, apply the newest priors.
+  void Exchange();
+  // Supervisor (node.cpp) and the end-of-run outputs (node_report.cpp).
+  link::Telemetry MakeTelemetry() const;
+  void PrintStatus(double since_start_s);
+  void WriteOutputs();
+  void PrintReport();
+};
+
+}  // namespace msgraphs::runtime

@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: MIT
+// What a node leaves behind when it stops: its keyframes (TUM), where it placed every other
+// robot (origins.csv), and a report on stdout (and in report.txt).
+#include <sys/resource.h>
+
+#include <cinttypes>
+#include <cstdarg>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "node_impl.hpp"
+
+namespace msgraphs::runtime {
+
+namespace {
+
+void PutPose(std::ostream& out, const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.linear());
+  const Eigen::Vector3d& t = T.translation();
+  out << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z()
+      << ' ' << q.w();
+}
+
+// printf into a growing report; the attribute keeps the format checks.
+__attribute__((format(printf, 2, 3))) void Appendf(std::string& text, const char* format, ...) {
+  char line[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(line, sizeof line, format, args);
+  va_end(args);
+  text += line;
+}
+
+std::string Kilobytes(std::uint64_t bytes) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.1f kB", static_cast<double>(bytes) / 1e3);
+  return buffer;
+}
+
+}  // namespace
+
+void Node::Impl::WriteOutputs() {
+  if (config.output_dir.empty()) return;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(config.output_dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "msgraphs_node: cannot create %s: %s\n", config.output_dir.c_str(),
+                 ec.message().c_str());
+    return;
+  }
+  // Written beside and renamed: a reader never sees half a file.
+  auto write = [&](const char* name, auto&& body) {
+    const fs::path final_path = fs::path(config.output_dir) / name;
+    const fs::path temp = final_path.string() + ".tmp";
+    {
+      std::ofstream out(temp);
+      out.precision(9);
+      body(out);
+      if (!out) {
+        std::fprintf(stderr, "msgraphs_node: cannot write %s\n", temp.c_str());
+        return;
+      }
+    }
+    fs::rename(temp, final_path, ec);
+  };
+  const core::SGraph& graph = mapper.graph();
+  write("keyframes.tum", [&](std::ostream& out) {
+    out << "# robot " << config.robot.value << " keyframes in its map frame: t x y z qx qy qz qw\n";
+    for (std::uint32_t k = 0; k < graph.keyframe_slots(); ++k) {
+      if (!graph.keyframe_active(k)) continue;
+      out << std::fixed << graph.keyframe_stamp(k) << ' ';
+      out.unsetf(std::ios::fixed);
+      PutPose(out, graph.keyframe_pose(k));
+      out << '\n';
+    }
+  });
+  std::lock_guard<std::mutex> lock(session_mutex);
+  write("origins.csv", [&](std::ostream& out) {
+    out << "robot,merged,x,y,z,qx,qy,qz,qw\n";
+    for (std::size_t i = 0; i < session.peers(); ++i) {
+      const core::CollabPeerStats p = session.peer_stats(i);
+      out << p.robot << ',' << (p.merged ? 1 : 0) << ',';
+      const Eigen::Isometry3d T = session.T_self_robot(p.robot);
+      const Eigen::Quaterniond q(T.linear());
+      out << T.translation().x() << ',' << T.translation().y() << ',' << T.translation().z() << ','
+          << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << '\n';
+    }
+  });
+}
+
+void Node::Impl::PrintReport() {
+  std::string text;
+  SlamStatus s;
+  {
+    std::lock_guard<std::mutex> lock(status_mutex);
+    s = slam_status;
+  }
+  Appendf(text,
+          "robot %u report: %" PRIu64 " scans, %" PRIu64
+          " keyframes, %u walls, %u rooms distilled\n",
+          config.robot.value, s.scans, s.keyframes, s.walls, s.rooms);
+  {
+    std::lock_guard<std::mutex> lock(session_mutex);
+    const core::CollabSessionStats& cs = session.stats();
+    for (std::size_t i = 0; i < session.peers(); ++i) {
+      const core::CollabPeerStats p = session.peer_stats(i);
+      const Eigen::Isometry3d T = session.T_self_robot(p.robot);
+      Appendf(text,
+              "  robot %u: %s, %zu walls, %zu rooms, %zu matches accepted of %zu; origin (%.2f, "
+              "%.2f, %.2f) m\n",
+              p.robot, p.merged ? "merged" : "NOT merged", p.walls, p.rooms, p.consistent,
+              p.matches, T.translation().x(), T.translation().y(), T.translation().z());
+      Appendf(text,
+              "    received: graph %s, descriptors %s, requests %s, clouds %s; malformed %" PRIu64
+              ", graph gaps %" PRIu64 "\n",
+              Kilobytes(p.bytes_received[0]).c_str(), Kilobytes(p.bytes_received[1]).c_str(),
+              Kilobytes(p.bytes_received[2]).c_str(), Kilobytes(p.bytes_received[3]).c_str(),
+              p.malformed, p.graph_gaps);
+    }
+    Appendf(text,
+            "  room matches: %" PRIu64 " proposed, %" PRIu64 " rejected by fine alignment, %" PRIu64
+            " rejected against the merged estimate, %" PRIu64
+            " outside the consistent sets, %" PRIu64 " accepted\n",
+            cs.proposals, cs.rejected_fine, cs.rejected_anchored, cs.rejected_consistency,
+            cs.accepted);
+    Appendf(text, "  sent: graph %s, descriptors %s, requests %s, clouds %s\n",
+            Kilobytes(cs.bytes_sent[0]).c_str(), Kilobytes(cs.bytes_sent[1]).c_str(),
+            Kilobytes(cs.bytes_sent[2]).c_str(), Kilobytes(cs.bytes_sent[3]).c_str());
+  }
+  const link::LinkStats ls = link->stats();
+  std::uint64_t rejected[4] = {};
+  std::uint64_t lost = 0, write_failures = 0;
+  for (const link::TopicStats& t : ls.topics) {
+    rejected[0] += t.rejected_version;
+    rejected[1] += t.rejected_sender;
+    rejected[2] += t.rejected_oversize;
+    rejected[3] += t.undecodable;
+    lost += t.lost;
+    write_failures += t.write_failures;
+  }
+  Appendf(text,
+          "  link: rejected %" PRIu64 " unknown version, %" PRIu64 " bad sender, %" PRIu64
+          " oversize, %" PRIu64 " undecodable; %" PRIu64 " lost, %" PRIu64
+          " write failures; %" PRIu64 " resends for peers, %" PRIu64
+          " resync requests; robots appeared %" PRIu64 ", vanished %" PRIu64 "\n",
+          rejected[0], rejected[1], rejected[2], rejected[3], lost, write_failures, resends.load(),
+          resyncs_requested.load(), ls.robots_appeared, ls.robots_vanished);
+  const auto sq = scans.stats(), oq = odometry.stats();
+  Appendf(text,
+          "  queues: scans peak %zu/%zu, dropped %" PRIu64
+          "; odometry peak %zu/%zu, dropped %" PRIu64 "\n",
+          sq.peak, sq.capacity, sq.dropped, oq.peak, oq.capacity, oq.dropped);
+  Appendf(text,
+          "  latency: keyframe %.1f ms p50, %.1f ms p99; last packet to distilled update on the "
+          "wire %.0f ms p50, "
+          "%.0f ms p99, %.0f ms max (%" PRIu64 " keyframes)\n",
+          s.keyframe_p50_ms, s.keyframe_p99_ms, s.wire_p50_ms, s.wire_p99_ms, s.wire_max_ms,
+          s.wire_samples);
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  Appendf(text, "  resources: CPU %.1f s user + %.1f s system, peak RSS %.1f MB\n",
+          static_cast<double>(usage.ru_utime.tv_sec) +
+              static_cast<double>(usage.ru_utime.tv_usec) * 1e-6,
+          static_cast<double>(usage.ru_stime.tv_sec) +
+              static_cast<double>(usage.ru_stime.tv_usec) * 1e-6,
+          static_cast<double>(usage.ru_maxrss) / 1024.0);
+  std::fputs(text.c_str(), stdout);
+  std::fflush(stdout);
+  if (!config.output_dir.empty()) {
+    std::ofstream out(std::filesystem::path(config.output_dir) / "report.txt");
+    out << text;
+  }
+}
+
+}  // namespace msgraphs::runtime

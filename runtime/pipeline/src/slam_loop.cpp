@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: MIT
+// The SLAM thread: odometry and scans into the local S-Graph; every exchange period (sensor
+// time) the distilled graph and room descriptors go out through the session, and the newest
+// wall priors from the other robots come in. After the inputs end it keeps serving: it
+// publishes again when a peer asks for a resync or new priors arrive.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "msgraphs/platform/clock.hpp"
+#include "msgraphs/platform/realtime.hpp"
+#include "node_impl.hpp"
+
+namespace msgraphs::runtime {
+
+namespace {
+
+constexpr Duration kWait = Duration::FromMilliseconds(20);
+/// Live inputs: a scan waits this long for the odometry that covers its end.
+constexpr Duration kOdometryPatience = Duration::FromMilliseconds(500);
+/// A scan needs odometry up to its end plus this (the mapper interpolates).
+constexpr double kOdometryMargin_s = 0.05;
+
+}  // namespace
+
+void LatencyWindow::Add(double ms) {
+  values_[count_ % values_.size()] = ms;
+  ++count_;
+}
+
+double LatencyWindow::Percentile(double p) const {
+  const std::size_t n = std::min<std::size_t>(count_, values_.size());
+  if (n == 0) return 0;
+  // Called a few times per status line on at most 4096 values: a copy is fine here.
+  std::vector<double> sorted(values_.begin(), values_.begin() + static_cast<std::ptrdiff_t>(n));
+  std::sort(sorted.begin(), sorted.end());
+  return sorted[std::min(n - 1, static_cast<std::size_t>(p * static_cast<double>(n)))];
+}
+
+void Node::Impl::Exchange() {
+  if (config.feedback) {
+    bool fresh = false;
+    {
+      std::lock_guard<std::mutex> lock(priors_mutex);
+      if (priors_generation != applied_priors_generation) {
+        applied_priors_generation = priors_generation;
+        std::copy_n(priors_mailbox.begin(), priors_count, priors_scratch.begin());
+        fresh = true;
+      }
+    }
+    if (fresh) {
+      static_cast<void>(mapper.SetPlanePriors(std::span(priors_scratch.data(), priors_count)));
+      // After the inputs ended no keyframe will trigger the full solve: run it here.
+      if (state.load() == link::NodeState::kInputDone) static_cast<void>(mapper.Finish());
+    }
+  }
+  std::uint32_t version = 0, walls = 0, rooms = 0;
+  {
+    std::lock_guard<std::mutex> lock(session_mutex);
+    static_cast<void>(session.Publish(mapper, *link));
+    const core::DistilledGraph& g = session.distilled();
+    version = g.version;
+    walls = static_cast<std::uint32_t>(g.walls.size());
+    rooms = static_cast<std::uint32_t>(g.rooms.size());
+  }
+  const SteadyTime now = platform::SteadyNow();
+  for (const SteadyTime t : unpublished_keyframes) wire_ms.Add((now - t).seconds() * 1e3);
+  unpublished_keyframes.clear();
+  std::lock_guard<std::mutex> lock(status_mutex);
+  slam_status.graph_version = version;
+  slam_status.walls = walls;
+  slam_status.rooms = rooms;
+  slam_status.publishes += 1;
+  slam_status.plane_priors = mapper.stats().plane_priors;
+  slam_status.wire_p50_ms = wire_ms.Percentile(0.5);
+  slam_status.wire_p99_ms = wire_ms.Percentile(0.99);
+  slam_status.wire_max_ms = wire_ms.Percentile(1.0);
+  slam_status.wire_samples = wire_ms.count();
+}
+
+void Node::Impl::SlamLoop() {
+  static_cast<void>(platform::SetCurrentThreadName("msg-slam"));
+  double next_exchange_s = -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  // Odometry into the mapper: in lock-step only what the next scan needs (the rest waits in
+  // the queue, holding the reader back), otherwise everything that has arrived.
+  auto drain_odometry = [&](double horizon_s) {
+    while (OdometrySlot* o = odometry.Front(Duration())) {
+      if (o->stamp_s > horizon_s) break;
+      static_cast<void>(mapper.AddOdometry(o->stamp_s, o->T_odom_base));
+      odometry.Pop();
+    }
+  };
+  auto odometry_ended = [&] { return odometry.closed() && odometry.Front(Duration()) == nullptr; };
+
+  while (!ShouldStop()) {
+    ScanSlot* scan = scans.Front(kWait);
+    if (scan == nullptr) {
+      drain_odometry(lockstep() ? -inf : inf);
+      if (scans.closed()) break;  // the LiDAR input ended (or failed)
+      continue;
+    }
+    const double needed_s = scan->end_s + kOdometryMargin_s;
+    drain_odometry(lockstep() ? needed_s + 0.05 : inf);
+    if (mapper.odometry().newest_stamp() < needed_s && !odometry_ended()) {
+      const bool patient =
+          lockstep() || platform::SteadyNow() - scan->last_packet < kOdometryPatience;
+      if (patient) {
+        static_cast<void>(odometry.Front(kWait));
+        continue;
+      }
+      // Live: the odometry is late; the mapper skips the scan and counts it (kNoOdometry).
+    }
+    state = link::NodeState::kMapping;
+    const SteadyTime t0 = platform::SteadyNow();
+    core::LidarScanView view{scan->points, scan->time_offset_s, scan->start_s, scan->end_s};
+    auto outcome = mapper.AddScan(view);
+    const double end_s = scan->end_s;
+    if (outcome && *outcome == core::ScanOutcome::kKeyframe) {
+      keyframe_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
+      if (unpublished_keyframes.size() < unpublished_keyframes.capacity())
+        unpublished_keyframes.push_back(scan->last_packet);
+    }
+    scans.Pop();
+    {
+      std::lock_guard<std::mutex> lock(status_mutex);
+      const auto& s = mapper.stats();
+      slam_status.scans = s.scans;
+      slam_status.keyframes = s.keyframes;
+      slam_status.no_odometry = s.no_odometry;
+      slam_status.keyframe_p50_ms = keyframe_ms.Percentile(0.5);
+      slam_status.keyframe_p99_ms = keyframe_ms.Percentile(0.99);
+    }
+    if (next_exchange_s < 0) next_exchange_s = end_s + config.exchange_period_s;
+    if (end_s >= next_exchange_s || publish_now.exchange(false)) {
+      Exchange();
+      while (next_exchange_s <= end_s) next_exchange_s += config.exchange_period_s;
+    }
+  }
+  if (ShouldStop()) return;
+
+  // The recording ended: a final full solve, then keep serving the fleet.
+  static_cast<void>(mapper.Finish());
+  state = link::NodeState::kInputDone;
+  Exchange();
+  const Duration period = Duration::FromSeconds(std::min(config.exchange_period_s, 1.0));
+  while (!ShouldStop()) {
+    {
+      std::unique_lock<std::mutex> lock(wake_mutex);
+      wake_slam.wait_for(lock, std::chrono::nanoseconds(period.nanoseconds()),
+                         [&] { return publish_now.load() || ShouldStop(); });
+    }
+    publish_now = false;
+    if (ShouldStop()) break;
+    Exchange();
+  }
+}
+
+}  // namespace msgraphs::runtime

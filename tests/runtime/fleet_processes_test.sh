@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# N msgraphs_node processes, one per simulated robot, on 127.0.0.1 with real Fast DDS: each maps
+# its own recording (pcap + candump, lock-step), they exchange distilled graphs, descriptors and
+# room clouds, and every robot must place every other one (msgraphs_fleet_ate against the truth).
+#
+#   fleet_processes_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_fleet_ate> <world file> \
+#                           <robots> <domain> [late]
+#
+# "late": the last robot
+# starts only after the others have finished their recordings, so it must catch up from the
+# transient-local history and the resync protocol.
+set -u
+node=$1; sim=$2; fleet_ate=$3; world=$4; robots=$5; domain=$6; late=${7:-}
+# Late: the first robots stay long enough for the last one to arrive.
+quiet_s=6; [[ $late == late ]] && quiet_s=30
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+"$sim" --world "$world" --out "$work/run" --robots "$robots" --duration-s 120 \
+  --seed 1 --shared-rooms 2 > "$work/sim.log" || { cat "$work/sim.log"; exit 1; }
+cat > "$work/robot.conf" <<CONF
+[robot]
+id = 1
+[lidar]
+source = pcap
+pcap = run/robot1/velodyne.pcap
+[odometry]
+source = candump
+candump = run/robot1/odometry.log
+[replay]
+pace = lockstep
+[link]
+domain = $domain
+loopback_only = true
+[runtime]
+status_period_s = 10
+exit_after_done_s = $quiet_s
+max_run_s = 240
+CONF
+start() {
+  local r=$1
+  "$node" --config "$work/robot.conf" --set robot.id="$r" \
+    --set lidar.pcap="run/robot$r/velodyne.pcap" --set odometry.candump="run/robot$r/odometry.log" \
+    --set output.dir="out/robot$r" > "$work/robot$r.log" 2>&1 &
+  pids[r]=$!
+}
+declare -a pids
+first_batch=$robots
+[[ $late == late ]] && first_batch=$((robots - 1))
+for ((r = 1; r <= first_batch; r++)); do start "$r"; done
+if [[ $late == late ]]; then
+  # Wait until the first robots' recordings have ended, then start the last one.
+  for _ in $(seq 1 600); do
+    done_count=$(grep -l "input done" "$work"/robot[0-9]*.log 2>/dev/null | wc -l)
+    [[ $done_count -ge $first_batch ]] && break
+    sleep 0.2
+  done
+  echo "robot $robots joins late (the others' recordings have ended)"
+  start "$robots"
+fi
+rc=0
+for ((r = 1; r <= robots; r++)); do
+  if ! wait "${pids[r]}"; then echo "robot $r exited with an error"; rc=1; fi
+done
+for ((r = 1; r <= robots; r++)); do
+  echo "--- robot $r"; sed -n '/report:/,$p' "$work/robot$r.log"
+  grep -E "WARNING|error|failed" "$work/robot$r.log" | head -5
+done
+"$fleet_ate" --run "$work/run" --out "$work/out" --expect-merged --max-ate-m 0.15 || rc=1
+[[ $rc -eq 0 ]] && echo "PASS: every robot merged every other robot" || echo "FAIL"
+exit $rc
