@@ -142,8 +142,14 @@ Expected<std::size_t> EncodeDistilled(const DistilledGraph& g,
 
 Expected<std::uint16_t> DistilledSender(std::span<const std::uint8_t> bytes) {
   constexpr std::size_t kRobotAt = 6;  // magic (4), format, flags
-  if (bytes.size() < kDistilledHeaderBytes)
+  if (bytes.size() < kDistilledHeaderBytes + 4)
     return Error{Errc::kMalformed, "distilled graph: shorter than its header"};
+  if (std::memcmp(bytes.data(), kMagic, 4) != 0)
+    return Error{Errc::kMalformed, "distilled graph: bad magic"};
+  // Checked before the receiver files the message under a robot: garbage must not invent one.
+  const std::size_t body = bytes.size() - 4;
+  if (ReadU32Le(&bytes[body]) != Crc32(bytes.first(body)))
+    return Error{Errc::kChecksum, "distilled graph: CRC mismatch"};
   return ReadU16Le(&bytes[kRobotAt]);
 }
 

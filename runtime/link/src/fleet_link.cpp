@@ -248,12 +248,13 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
       if (!info.valid_data) continue;
       std::lock_guard<std::mutex> lock(mutex);
       TopicStats& s = stats.topics[kTelemetry];
-      if (msg.robot_id() == self.value) continue;  // our own writer, same topic
+      if (info.sample_identity.writer_guid() == writers[kTelemetry]->guid()) continue;  // ours
       if (msg.version() != idl::kTelemetryVersion) {
         ++s.rejected_version;
         continue;
       }
-      if (msg.robot_id() == 0 || msg.state() > idl::kStateStopping) {
+      if (msg.robot_id() == 0 || msg.robot_id() == self.value ||
+          msg.state() > idl::kStateStopping) {
         ++s.rejected_sender;
         continue;
       }
@@ -285,11 +286,21 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
   }
 
   // Checks the common fields of a received sample; true when the node should see it.
-  bool Admit(
-      int t, std::uint16_t version, std::uint16_t from, std::uint16_t to, std::size_t bytes) {
+  bool Admit(int t,
+             const dds::SampleInfo& info,
+             std::uint16_t version,
+             std::uint16_t from,
+             std::uint16_t to,
+             const std::vector<std::uint8_t>& payload) {
+    const std::size_t bytes = payload.size();
     std::lock_guard<std::mutex> lock(mutex);
     TopicStats& s = stats.topics[static_cast<std::size_t>(t)];
-    if (from == self.value) return false;  // our own writer, same topic
+    if (info.sample_identity.writer_guid() == writers[static_cast<std::size_t>(t)]->guid())
+      return false;  // our own writer, same topic
+    if (from == self.value) {
+      ++s.rejected_sender;  // someone else using our robot id
+      return false;
+    }
     if (version != idl::kCollabVersion) {
       ++s.rejected_version;
       return false;
@@ -304,6 +315,13 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
     }
     if (bytes > settings.max_payload_bytes[static_cast<std::size_t>(t)]) {
       ++s.rejected_oversize;
+      return false;
+    }
+    // The sample's sender must be the one inside the message (where the header is long enough
+    // to say; a shorter one is left to the decoder). Offsets: the codecs' headers.
+    const std::size_t sender_at = t == 0 ? 6 : t == 3 ? 6 : 5;
+    if (bytes >= sender_at + 2 && ReadU16Le(&payload[sender_at]) != from) {
+      ++s.rejected_sender;
       return false;
     }
     ++s.received;
@@ -324,8 +342,7 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
         case core::CollabMessageType::kDistilledGraph:
           if (reader->take_next_sample(&in_graph, &info) != ReturnCode_t::RETCODE_OK) return false;
           if (!info.valid_data) continue;
-          admitted =
-              Admit(t, in_graph.version(), in_graph.robot_id(), 0, in_graph.payload().size());
+          admitted = Admit(t, info, in_graph.version(), in_graph.robot_id(), 0, in_graph.payload());
           if (admitted) {
             copy(in_graph.payload());
             out.from = in_graph.robot_id();
@@ -336,8 +353,8 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
           if (reader->take_next_sample(&in_descriptor, &info) != ReturnCode_t::RETCODE_OK)
             return false;
           if (!info.valid_data) continue;
-          admitted = Admit(t, in_descriptor.version(), in_descriptor.robot_id(), 0,
-                           in_descriptor.payload().size());
+          admitted = Admit(t, info, in_descriptor.version(), in_descriptor.robot_id(), 0,
+                           in_descriptor.payload());
           if (admitted) {
             copy(in_descriptor.payload());
             out.from = in_descriptor.robot_id();
@@ -348,8 +365,8 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
           if (reader->take_next_sample(&in_request, &info) != ReturnCode_t::RETCODE_OK)
             return false;
           if (!info.valid_data) continue;
-          admitted = Admit(t, in_request.version(), in_request.robot_id(), in_request.addressee(),
-                           in_request.payload().size());
+          admitted = Admit(t, info, in_request.version(), in_request.robot_id(),
+                           in_request.addressee(), in_request.payload());
           if (admitted) {
             copy(in_request.payload());
             out.from = in_request.robot_id();
@@ -359,8 +376,8 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
         case core::CollabMessageType::kRoomCloud:
           if (reader->take_next_sample(&in_cloud, &info) != ReturnCode_t::RETCODE_OK) return false;
           if (!info.valid_data) continue;
-          admitted = Admit(t, in_cloud.version(), in_cloud.robot_id(), in_cloud.addressee(),
-                           in_cloud.payload().size());
+          admitted = Admit(t, info, in_cloud.version(), in_cloud.robot_id(), in_cloud.addressee(),
+                           in_cloud.payload());
           if (admitted) {
             copy(in_cloud.payload());
             out.from = in_cloud.robot_id();
@@ -420,6 +437,9 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
     dds::DataWriterQos w = dds::DATAWRITER_QOS_DEFAULT;
     w.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     w.reliability().max_blocking_time = ToDds(0.1);
+    // Repairs follow the writer's heartbeat: 0.5 s instead of the default 3 s keeps a lossy
+    // radio's retransmissions prompt for a few dozen bytes a second per reader.
+    w.reliable_writer_qos().times.heartbeatPeriod = ToDds(0.5);
     w.durability().kind =
         state ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
     w.history().kind = dds::KEEP_LAST_HISTORY_QOS;

@@ -126,6 +126,9 @@ void Node::Impl::PrintReport() {
             " outside the consistent sets, %" PRIu64 " accepted\n",
             cs.proposals, cs.rejected_fine, cs.rejected_anchored, cs.rejected_consistency,
             cs.accepted);
+    Appendf(text,
+            "  collab decoders refused %" PRIu64 " messages (malformed, CRC, unknown format)\n",
+            cs.malformed);
     Appendf(text, "  sent: graph %s, descriptors %s, requests %s, clouds %s\n",
             Kilobytes(cs.bytes_sent[0]).c_str(), Kilobytes(cs.bytes_sent[1]).c_str(),
             Kilobytes(cs.bytes_sent[2]).c_str(), Kilobytes(cs.bytes_sent[3]).c_str());
@@ -133,6 +136,14 @@ void Node::Impl::PrintReport() {
   const link::LinkStats ls = link->stats();
   std::uint64_t rejected[4] = {};
   std::uint64_t lost = 0, write_failures = 0;
+  std::string lost_topics;
+  const char* topic_names[] = {"graph", "descriptors", "requests", "clouds", "telemetry"};
+  for (std::size_t i = 0; i < ls.topics.size(); ++i) {
+    if (ls.topics[i].lost == 0) continue;
+    lost_topics += std::string(lost_topics.empty() ? " (" : ", ") + topic_names[i] + " " +
+                   std::to_string(ls.topics[i].lost);
+  }
+  if (!lost_topics.empty()) lost_topics += ")";
   for (const link::TopicStats& t : ls.topics) {
     rejected[0] += t.rejected_version;
     rejected[1] += t.rejected_sender;
@@ -143,11 +154,12 @@ void Node::Impl::PrintReport() {
   }
   Appendf(text,
           "  link: rejected %" PRIu64 " unknown version, %" PRIu64 " bad sender, %" PRIu64
-          " oversize, %" PRIu64 " undecodable; %" PRIu64 " lost, %" PRIu64
+          " oversize, %" PRIu64 " undecodable; %" PRIu64 " lost%s, %" PRIu64
           " write failures; %" PRIu64 " resends for peers, %" PRIu64
           " resync requests; robots appeared %" PRIu64 ", vanished %" PRIu64 "\n",
-          rejected[0], rejected[1], rejected[2], rejected[3], lost, write_failures, resends.load(),
-          resyncs_requested.load(), ls.robots_appeared, ls.robots_vanished);
+          rejected[0], rejected[1], rejected[2], rejected[3], lost, lost_topics.c_str(),
+          write_failures, resends.load(), resyncs_requested.load(), ls.robots_appeared,
+          ls.robots_vanished);
   const auto sq = scans.stats(), oq = odometry.stats();
   Appendf(text,
           "  queues: scans peak %zu/%zu, dropped %" PRIu64

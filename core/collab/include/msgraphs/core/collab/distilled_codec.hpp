@@ -51,7 +51,7 @@ Expected<DistilledDelta> DecodeDistilled(std::span<const std::uint8_t> bytes,
                                          const DistilledGraph* known = nullptr);
 
 /// The sending robot's id from a message's header (before decoding it against that robot's
-/// copy); kMalformed when the bytes are too short to hold a header.
+/// copy), once magic and CRC are right: kMalformed (short, bad magic) or kChecksum otherwise.
 Expected<std::uint16_t> DistilledSender(std::span<const std::uint8_t> bytes);
 
 /// Merges a decoded delta into the receiver's copy (upsert by id). kCapacityExceeded (what fit
