@@ -490,12 +490,14 @@ TEST(CollabSession, CountsAndRefusesBadOrHostileMessagesAndKeepsWorking) {
   EXPECT_DOUBLE_EQ(session.peer_graph(2)->floor_z_m, static_cast<double>(-0.6f));
   EXPECT_EQ(session.peer_stats(0).bytes_received[0], bytes.size());
 
-  // A flipped bit fails the CRC: counted against the peer, nothing changes.
+  // A flipped bit fails the CRC: counted, nothing changes. Not against the peer: a corrupt
+  // message's sender id cannot be trusted (garbage must not create or blame a peer).
   auto corrupt = bytes;
   corrupt[30] ^= 0x10;
   EXPECT_FALSE(session.Receive(CollabMessageType::kDistilledGraph, corrupt, out));
   EXPECT_EQ(session.stats().malformed, 1u);
-  EXPECT_EQ(session.peer_stats(0).malformed, 1u);
+  EXPECT_EQ(session.peer_stats(0).malformed, 0u);
+  EXPECT_EQ(session.peers(), 1u);
   // A message claiming to come from ourselves, and one whose type lies about its content.
   g.robot = 1;
   EXPECT_FALSE(session.Receive(CollabMessageType::kDistilledGraph, EncodedGraph(g, 0), out));
