@@ -42,7 +42,16 @@ void Node::Impl::CollabLoop() {
       std::lock_guard<std::mutex> lock(session_mutex);
       do {
         // Malformed messages are counted by the session (per peer) and dropped here.
-        if (session.Receive(message.type, message.bytes, *link)) changed = true;
+        if (session.Receive(message.type, message.bytes, *link)) {
+          changed = true;
+          // Peers' graphs and descriptors into the checkpoint; requests are answered already
+          // and clouds are asked for again when needed.
+          if (message.type == core::CollabMessageType::kDistilledGraph ||
+              message.type == core::CollabMessageType::kRoomDescriptor)
+            Journal([&](JournalWriter& j) {
+              return static_cast<bool>(j.Message(message.type, message.bytes));
+            });
+        }
         ++received;
       } while (received < kMessagesPerRound && link->Receive(message, Duration()));
     }

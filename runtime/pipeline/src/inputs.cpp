@@ -70,6 +70,8 @@ void Node::Impl::LidarLoop() {
     while (!ShouldStop()) {
       const drivers::velodyne::Scan* scan = recorded->Next();
       if (scan == nullptr) break;
+      // Resumed from a checkpoint: what the map already holds is skipped, without pacing.
+      if (scan->end_time.seconds_since_epoch() <= resume_scans_after_s) continue;
       if (!lockstep()) {
         const SteadyTime due =
             replay_clock->Due(scan->end_time.seconds_since_epoch(), platform::SteadyNow());
@@ -179,6 +181,12 @@ void Node::Impl::OdometryLoop() {
       if (!*next) {
         odometry_counters.done = true;
         break;
+      }
+      // Resumed: the integrator still sees every frame (it integrates them), the queue only
+      // the samples after the checkpoint's last.
+      if (line.stamp.seconds_since_epoch() <= resume_odometry_after_s) {
+        static_cast<void>(stream->Add(line.frame, line.stamp));
+        continue;
       }
       if (!lockstep()) {
         const SteadyTime due =

@@ -3,6 +3,7 @@
 // conditions, on the caller's thread.
 #include <cinttypes>
 #include <cstdio>
+#include <filesystem>
 
 #include "msgraphs/drivers/gpio/gpio.hpp"
 #include "msgraphs/platform/clock.hpp"
@@ -20,6 +21,40 @@ const char* PaceName(const config::NodeConfig& c) {
   if (c.lidar_source == config::LidarSource::kUdp) return "live";
   return c.pace == config::Pace::kLockstep ? "recorded, lock-step" : "recorded pace";
 }
+
+// Discards what the session would send while it is rebuilt from the journal.
+class NullOutbox final : public core::CollabOutbox {
+ public:
+  void Send(core::CollabMessageType, std::uint16_t, std::span<const std::uint8_t>) override {}
+};
+
+// Rebuilds the mapper and the session from the checkpoint journal.
+class Restore final : public JournalSink {
+ public:
+  Restore(core::LocalMapper& mapper, core::CollabSession& session)
+      : mapper_(mapper), session_(session) {}
+  void OnOdometry(double stamp_s, const Eigen::Isometry3d& T) override {
+    static_cast<void>(mapper_.AddOdometry(stamp_s, T));
+  }
+  void OnScan(std::span<const Eigen::Vector3f> points,
+              std::span<const float> times,
+              double start_s,
+              double end_s) override {
+    static_cast<void>(mapper_.AddScan({points, times, start_s, end_s}));
+  }
+  void OnPriors(std::span<const core::PlanePrior> priors) override {
+    static_cast<void>(mapper_.SetPlanePriors(priors));
+  }
+  void OnFinish() override { static_cast<void>(mapper_.Finish()); }
+  void OnMessage(core::CollabMessageType type, std::span<const std::uint8_t> bytes) override {
+    static_cast<void>(session_.Receive(type, bytes, outbox_));
+  }
+
+ private:
+  core::LocalMapper& mapper_;
+  core::CollabSession& session_;
+  NullOutbox outbox_;
+};
 
 }  // namespace
 
@@ -65,6 +100,36 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
   m.unpublished_keyframes.reserve(4096);
   if (config.pace == config::Pace::kRecorded)
     m.replay_clock = std::make_unique<ReplayClock>(config.speed);
+
+  if (!config.checkpoint_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(config.checkpoint_dir, ec);
+    const std::string path =
+        (std::filesystem::path(config.checkpoint_dir) / "journal.bin").string();
+    const SteadyTime t0 = platform::SteadyNow();
+    Restore restore(m.mapper, m.session);
+    auto replay = ReplayJournal(path, config.robot.value, restore);
+    if (!replay) return fail("checkpoint", replay.error());
+    if (replay->records > 0) {
+      NullOutbox discard;
+      m.session.Match(discard);
+      std::printf(
+          "resumed from checkpoint %s: %llu keyframes, %llu odometry samples, %llu peer messages, "
+          "%llu prior updates in %.1f s%s%s\n",
+          path.c_str(), static_cast<unsigned long long>(replay->scans),
+          static_cast<unsigned long long>(replay->odometry),
+          static_cast<unsigned long long>(replay->messages),
+          static_cast<unsigned long long>(replay->priors), (platform::SteadyNow() - t0).seconds(),
+          replay->stopped.empty() ? "" : "; stopped early: ", replay->stopped.c_str());
+      m.resume_scans_after_s = replay->last_scan_end_s;
+      m.resume_odometry_after_s = replay->last_odometry_s;
+      std::lock_guard<std::mutex> lock(m.status_mutex);
+      m.slam_status.keyframes = m.mapper.stats().keyframes;
+    }
+    auto writer = JournalWriter::Open(path, config.robot.value, replay->valid_bytes);
+    if (!writer) return fail("checkpoint", writer.error());
+    m.journal.emplace(std::move(*writer));
+  }
 
   auto link = link::FleetLink::Create(config.robot, config.link);
   if (!link) return fail("DDS link", link.error());

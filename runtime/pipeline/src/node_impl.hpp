@@ -21,6 +21,7 @@
 #include "msgraphs/drivers/gpio/status_led.hpp"
 #include "msgraphs/runtime/link/fleet_link.hpp"
 #include "msgraphs/runtime/pipeline/bounded_queue.hpp"
+#include "msgraphs/runtime/pipeline/journal.hpp"
 #include "msgraphs/runtime/pipeline/node.hpp"
 #include "msgraphs/runtime/pipeline/replay_clock.hpp"
 
@@ -129,6 +130,18 @@ struct Node::Impl {
   std::unique_ptr<drivers::gpio::GpioProvider> gpio;
   std::unique_ptr<drivers::gpio::DigitalOutput> led_line;
   std::unique_ptr<drivers::gpio::StatusLed> led;
+
+  // Checkpoint (optional): the journal, shared by the SLAM and collab threads.
+  std::mutex journal_mutex;
+  std::optional<JournalWriter> journal;
+  std::atomic<std::uint64_t> journal_errors{0};
+  /// Restored from the journal: recorded inputs skip what is already in the map.
+  double resume_scans_after_s = -1, resume_odometry_after_s = -1;
+  void Journal(auto&& write) {
+    if (!journal) return;
+    std::lock_guard<std::mutex> lock(journal_mutex);
+    if (!write(*journal)) journal_errors.fetch_add(1, std::memory_order_relaxed);
+  }
 
   std::vector<std::thread> threads;
   // PrintStatus's previous counters (supervisor thread only), for rates.

@@ -171,6 +171,13 @@ void Node::Impl::PrintReport() {
           "%.0f ms p99, %.0f ms max (%" PRIu64 " keyframes)\n",
           s.keyframe_p50_ms, s.keyframe_p99_ms, s.wire_p50_ms, s.wire_p99_ms, s.wire_max_ms,
           s.wire_samples);
+  if (journal) {
+    std::lock_guard<std::mutex> lock(journal_mutex);
+    Appendf(text,
+            "  checkpoint journal: %" PRIu64 " records written this run, %.1f MB in all, %" PRIu64
+            " write errors\n",
+            journal->records(), static_cast<double>(journal->bytes()) / 1e6, journal_errors.load());
+  }
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   Appendf(text, "  resources: CPU %.1f s user + %.1f s system, peak RSS %.1f MB\n",

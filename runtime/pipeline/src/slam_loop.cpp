@@ -49,9 +49,14 @@ void Node::Impl::Exchange() {
       }
     }
     if (fresh) {
-      static_cast<void>(mapper.SetPlanePriors(std::span(priors_scratch.data(), priors_count)));
+      const std::span<const core::PlanePrior> priors(priors_scratch.data(), priors_count);
+      static_cast<void>(mapper.SetPlanePriors(priors));
+      Journal([&](JournalWriter& j) { return static_cast<bool>(j.Priors(priors)); });
       // After the inputs ended no keyframe will trigger the full solve: run it here.
-      if (state.load() == link::NodeState::kInputDone) static_cast<void>(mapper.Finish());
+      if (state.load() == link::NodeState::kInputDone) {
+        static_cast<void>(mapper.Finish());
+        Journal([](JournalWriter& j) { return static_cast<bool>(j.Finish()); });
+      }
     }
   }
   std::uint32_t version = 0, walls = 0, rooms = 0;
@@ -81,6 +86,7 @@ void Node::Impl::Exchange() {
 void Node::Impl::SlamLoop() {
   static_cast<void>(platform::SetCurrentThreadName("msg-slam"));
   double next_exchange_s = -1;
+  SteadyTime next_sync = platform::SteadyNow() + Duration::FromSeconds(config.checkpoint_sync_s);
   const double inf = std::numeric_limits<double>::infinity();
   // Odometry into the mapper: in lock-step only what the next scan needs (the rest waits in
   // the queue, holding the reader back), otherwise everything that has arrived.
@@ -88,6 +94,9 @@ void Node::Impl::SlamLoop() {
     while (OdometrySlot* o = odometry.Front(Duration())) {
       if (o->stamp_s > horizon_s) break;
       static_cast<void>(mapper.AddOdometry(o->stamp_s, o->T_odom_base));
+      Journal([&](JournalWriter& j) {
+        return static_cast<bool>(j.Odometry(o->stamp_s, o->T_odom_base));
+      });
       odometry.Pop();
     }
   };
@@ -118,6 +127,11 @@ void Node::Impl::SlamLoop() {
     const double end_s = scan->end_s;
     if (outcome && *outcome == core::ScanOutcome::kKeyframe) {
       keyframe_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
+      // Only keyframes change the mapper: only they are journaled.
+      Journal([&](JournalWriter& j) {
+        return static_cast<bool>(j.Scan(view.points_lidar, view.time_offset_s, view.start_s,
+                                        view.end_s, config.mapper.max_range_m));
+      });
       if (unpublished_keyframes.size() < unpublished_keyframes.capacity())
         unpublished_keyframes.push_back(scan->last_packet);
     }
@@ -131,6 +145,10 @@ void Node::Impl::SlamLoop() {
       slam_status.keyframe_p50_ms = keyframe_ms.Percentile(0.5);
       slam_status.keyframe_p99_ms = keyframe_ms.Percentile(0.99);
     }
+    if (journal && platform::SteadyNow() >= next_sync) {
+      Journal([](JournalWriter& j) { return static_cast<bool>(j.Sync()); });
+      next_sync = platform::SteadyNow() + Duration::FromSeconds(config.checkpoint_sync_s);
+    }
     if (next_exchange_s < 0) next_exchange_s = end_s + config.exchange_period_s;
     if (end_s >= next_exchange_s || publish_now.exchange(false)) {
       Exchange();
@@ -141,6 +159,7 @@ void Node::Impl::SlamLoop() {
 
   // The recording ended: a final full solve, then keep serving the fleet.
   static_cast<void>(mapper.Finish());
+  Journal([](JournalWriter& j) { return j.Finish() && j.Sync(); });
   state = link::NodeState::kInputDone;
   Exchange();
   const Duration period = Duration::FromSeconds(std::min(config.exchange_period_s, 1.0));

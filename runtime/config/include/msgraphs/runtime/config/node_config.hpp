@@ -75,6 +75,10 @@ struct NodeConfig {
   std::string led_line;  ///< line name or offset on the chip
   bool led_active_low = false;
 
+  // [checkpoint]
+  std::string checkpoint_dir;      ///< empty: no checkpoint; else the journal lives here
+  double checkpoint_sync_s = 5.0;  ///< fsync period (power-cut safety)
+
   // [output]
   std::string output_dir;  ///< empty: no files at exit
 };
