@@ -1,14 +1,20 @@
-# msgraphs_fastddsgen(<target> <idl>...): a static library of the C++ that fastddsgen generates
+# msgraphs_fastddsgen(<target> [ROS2] <idl>...): a static library of the C++ that fastddsgen generates
 # from the IDL files at build time, so the generated code always matches the IDL and the
 # installed Fast DDS. Generated sources are not project code: included as SYSTEM headers so
 # their warnings stay out of ours. fastddsgen runs on the build machine, also when
 # cross-compiling.
 find_program(MSGRAPHS_FASTDDSGEN fastddsgen REQUIRED)
 
+# ROS2: -typeros2, the type names rmw_fastrtps uses ("pkg::msg::dds_::Msg_").
 function(msgraphs_fastddsgen target)
+  cmake_parse_arguments(arg "ROS2" "" "" ${ARGN})
   set(gen_dir ${CMAKE_CURRENT_BINARY_DIR}/${target}_gen)
   set(sources "")
-  foreach(idl IN LISTS ARGN)
+  set(flags "")
+  if(arg_ROS2)
+    set(flags -typeros2)
+  endif()
+  foreach(idl IN LISTS arg_UNPARSED_ARGUMENTS)
     get_filename_component(name ${idl} NAME_WE)
     get_filename_component(idl_path ${idl} ABSOLUTE)
     set(outputs ${gen_dir}/${name}.cxx ${gen_dir}/${name}.h
@@ -16,7 +22,7 @@ function(msgraphs_fastddsgen target)
     add_custom_command(
       OUTPUT ${outputs}
       COMMAND ${CMAKE_COMMAND} -E make_directory ${gen_dir}
-      COMMAND ${MSGRAPHS_FASTDDSGEN} -replace -d ${gen_dir} ${idl_path} > ${gen_dir}/${name}.fastddsgen.log
+      COMMAND ${MSGRAPHS_FASTDDSGEN} ${flags} -replace -d ${gen_dir} ${idl_path} > ${gen_dir}/${name}.fastddsgen.log
       DEPENDS ${idl_path}
       COMMENT "fastddsgen ${name}.idl"
       VERBATIM)

@@ -4,13 +4,16 @@
 # room clouds, and every robot must place every other one (msgraphs_fleet_ate against the truth).
 #
 #   fleet_processes_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_fleet_ate> <world file> \
-#                           <robots> <domain> [late]
+#                           <robots> <domain> [late | ros=<ros2_listener>]
 #
-# "late": the last robot
+# "ros=...": a ROS 2 subscriber (as RViz2 subscribes) must receive robot 1's walls, rooms,
+# trajectory, map cloud and TF while the fleet runs. "late": the last robot
 # starts only after the others have finished their recordings, so it must catch up from the
 # transient-local history and the resync protocol.
 set -u
 node=$1; sim=$2; fleet_ate=$3; world=$4; robots=$5; domain=$6; late=${7:-}
+ros_listener=""
+[[ $late == ros=* ]] && { ros_listener=${late#ros=}; late=""; }
 # Late: the first robots stay long enough for the last one to arrive.
 quiet_s=6; [[ $late == late ]] && quiet_s=30
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
@@ -46,6 +49,10 @@ declare -a pids
 first_batch=$robots
 [[ $late == late ]] && first_batch=$((robots - 1))
 for ((r = 1; r <= first_batch; r++)); do start "$r"; done
+if [[ -n $ros_listener ]]; then
+  "$ros_listener" --domain "$domain" --robot 1 --seconds 120 > "$work/ros.log" 2>&1 &
+  ros_pid=$!
+fi
 if [[ $late == late ]]; then
   # Wait until the first robots' recordings have ended, then start the last one.
   for _ in $(seq 1 600); do
@@ -64,6 +71,10 @@ for ((r = 1; r <= robots; r++)); do
   echo "--- robot $r"; sed -n '/report:/,$p' "$work/robot$r.log"
   grep -E "WARNING|error|failed" "$work/robot$r.log" | head -5
 done
+if [[ -n $ros_listener ]]; then
+  wait $ros_pid || { echo "the ROS 2 subscriber did not get every topic"; rc=1; }
+  cat "$work/ros.log"
+fi
 "$fleet_ate" --run "$work/run" --out "$work/out" --expect-merged --max-ate-m 0.15 || rc=1
 [[ $rc -eq 0 ]] && echo "PASS: every robot merged every other robot" || echo "FAIL"
 exit $rc

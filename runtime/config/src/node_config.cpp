@@ -263,6 +263,9 @@ bool ParseNodeConfig(const std::string& text,
   r.String("led", "line", c.led_line);
   r.Bool("led", "active_low", c.led_active_low);
 
+  r.Bool("ros", "enabled", c.ros_enabled);
+  r.Number("ros", "cloud_period_s", 0.5, 3600, c.ros_cloud_period_s);
+
   r.Path("checkpoint", "dir", c.checkpoint_dir);
   r.Number("checkpoint", "sync_period_s", 0.1, 3600, c.checkpoint_sync_s);
 

@@ -621,6 +621,8 @@ std::vector<FleetLink::PeerView> FleetLink::Peers() const {
   return out;
 }
 
+void* FleetLink::participant() const { return impl_->participant; }
+
 int FleetLink::matched_readers() const {
   dds::PublicationMatchedStatus status;
   impl_->writers[kTelemetry]->get_publication_matched_status(status);

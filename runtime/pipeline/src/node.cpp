@@ -134,6 +134,11 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
   auto link = link::FleetLink::Create(config.robot, config.link);
   if (!link) return fail("DDS link", link.error());
   m.link = std::move(*link);
+  if (config.ros_enabled) {
+    auto ros = link::RosPublisher::Create(*m.link, "robot" + std::to_string(config.robot.value));
+    if (!ros) return fail("ROS 2 topics", ros.error());
+    m.ros = std::move(*ros);
+  }
 
   if (!config.led_chip.empty()) {
     m.gpio = drivers::gpio::MakeLibgpiodProvider();

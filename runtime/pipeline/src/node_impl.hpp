@@ -20,6 +20,7 @@
 #include "msgraphs/drivers/gpio/gpio.hpp"
 #include "msgraphs/drivers/gpio/status_led.hpp"
 #include "msgraphs/runtime/link/fleet_link.hpp"
+#include "msgraphs/runtime/link/ros_publisher.hpp"
 #include "msgraphs/runtime/pipeline/bounded_queue.hpp"
 #include "msgraphs/runtime/pipeline/journal.hpp"
 #include "msgraphs/runtime/pipeline/node.hpp"
@@ -110,6 +111,11 @@ struct Node::Impl {
   mutable std::mutex session_mutex;
   core::CollabSession session;
   std::unique_ptr<link::FleetLink> link;
+  std::unique_ptr<link::RosPublisher> ros;  ///< SLAM thread only (Exchange)
+  link::RosMapView ros_view;
+  SteadyTime ros_cloud_last;
+  bool ros_cloud_sent = false;
+  void PublishRos();
   // Wall priors computed by the collab thread, applied by the SLAM thread at its next exchange.
   std::mutex priors_mutex;
   std::vector<core::PlanePrior> priors_mailbox, priors_scratch, priors_scratch_collab;

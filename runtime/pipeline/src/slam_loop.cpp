@@ -68,6 +68,7 @@ void Node::Impl::Exchange() {
     walls = static_cast<std::uint32_t>(g.walls.size());
     rooms = static_cast<std::uint32_t>(g.rooms.size());
   }
+  PublishRos();
   const SteadyTime now = platform::SteadyNow();
   for (const SteadyTime t : unpublished_keyframes) wire_ms.Add((now - t).seconds() * 1e3);
   unpublished_keyframes.clear();

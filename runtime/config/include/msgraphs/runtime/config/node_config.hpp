@@ -75,6 +75,10 @@ struct NodeConfig {
   std::string led_line;  ///< line name or offset on the chip
   bool led_active_low = false;
 
+  // [ros]: the map on ROS 2 topics for RViz2 (runtime/link ros_publisher.hpp)
+  bool ros_enabled = true;
+  double ros_cloud_period_s = 10.0;  ///< the map cloud at most this often (only while subscribed)
+
   // [checkpoint]
   std::string checkpoint_dir;      ///< empty: no checkpoint; else the journal lives here
   double checkpoint_sync_s = 5.0;  ///< fsync period (power-cut safety)

@@ -143,6 +143,8 @@ class FleetLink final : public core::CollabOutbox {
   LinkStats stats() const;
 
  private:
+  friend class RosPublisher;  // shares the participant
+  void* participant() const;
   struct Impl;
   explicit FleetLink(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
