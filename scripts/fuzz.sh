@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-60}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session node_config)
 DATA=${MSGRAPHS_DATA_DIR:-$(pwd)/../shared/data}
 
 cmake --preset fuzz >/dev/null
@@ -18,7 +18,9 @@ cmake --build --preset fuzz >/dev/null
 
 WORK=$(mktemp -d); trap 'rm -rf "$WORK"' EXIT
 mkdir -p build/fuzz/artifacts
-mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session}
+mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session,node_config}
+# The shipped example configuration seeds the config fuzzer.
+cp runtime/node/example.conf "$WORK/node_config/"
 if [ -d "$DATA/pcap" ]; then
   # Single packets of the einride recording, and the small captures whole.
   python3 - "$DATA/pcap/einride_vlp16_recording_1000pkts.bin" "$WORK/velodyne_decoder" <<'PY'

@@ -13,6 +13,10 @@ int RunHeartbeatMode(const HeartbeatModeOptions& options) {
   PrintBanner(options.robot_id);
   link::LinkSettings settings;
   settings.dds = options.dds;
+  if (Status valid = settings.Validate(); !valid) {
+    std::fprintf(stderr, "msgraphs_node: %s\n", valid.error().detail);
+    return 2;
+  }
   auto link = link::FleetLink::Create(options.robot_id, settings);
   if (!link) {
     std::fprintf(stderr, "msgraphs_node: DDS link: %s: %s\n", ToString(link.error().code),

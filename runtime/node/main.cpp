@@ -4,6 +4,7 @@
 //   msgraphs_node --config FILE [--set section.key=value]... [--check-config]
 //   msgraphs_node --self-check [--domain N]
 //   msgraphs_node --heartbeat --robot-id N [--domain N] [--loopback] [--peer IPv4]...
+//                 [--unicast | --discovery-server IPv4:PORT]
 //                 [--expect-peers K] [--duration-s S] [--rate-hz R]
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +22,7 @@ void Usage() {
       "usage: msgraphs_node --config FILE [--set section.key=value]... [--check-config]\n"
       "       msgraphs_node --self-check [--domain N]\n"
       "       msgraphs_node --heartbeat --robot-id N [--domain N] [--loopback] [--peer IPv4]...\n"
+      "                     [--unicast | --discovery-server IPv4:PORT]\n"
       "                     [--expect-peers K] [--duration-s S] [--rate-hz R]\n",
       stderr);
 }
@@ -72,6 +74,11 @@ int main(int argc, char** argv) {
       options.dds.loopback_only = true;
     } else if (arg == "--peer" && has_value) {
       options.dds.initial_peers.emplace_back(argv[++i]);
+    } else if (arg == "--unicast") {
+      options.dds.discovery = msgraphs::runtime::link::Discovery::kUnicast;
+    } else if (arg == "--discovery-server" && has_value) {
+      options.dds.discovery = msgraphs::runtime::link::Discovery::kServer;
+      options.dds.discovery_server = argv[++i];
     } else if (arg == "--expect-peers") {
       options.expect_peers = static_cast<int>(take_number(0, 1000));
     } else if (arg == "--duration-s") {

@@ -52,6 +52,8 @@ int RunSelfCheck(std::uint32_t domain_id) {
   PrintBanner(RobotId{});
   std::printf("\nself-check: Fast DDS exchange between two participants on 127.0.0.1 (domain %u)\n",
               domain_id);
+  // Through the UDP stack on 127.0.0.1, as between two robots' processes, not in memory.
+  link::DisableIntraprocessDelivery();
   link::LinkSettings settings;
   settings.dds.domain_id = domain_id;
   settings.dds.loopback_only = true;

@@ -287,6 +287,29 @@ TEST(RoomMatcher, ConsistencyCheckRejectsAPlantedSymmetricMismatch) {
   EXPECT_EQ(ConsistentMatches(std::span(matches).subspan(1, 2), config, keep), 0u);
 }
 
+TEST(RoomMatcher, ConsistencyCheckWaitsOnATieBetweenTwoHypotheses) {
+  // Two rooms of a symmetric pair each matched twice, one pair agreeing with the truth and the
+  // other with the building shifted by its period: 2 against 2 is no answer yet.
+  const Eigen::Isometry3d truth = Planar(4.0, -2.0, 0.7), shifted = Planar(6.0, 0, 0) * truth;
+  std::vector<RoomMatch> matches;
+  for (int i = 0; i < 4; ++i) {
+    RoomMatch m;
+    m.room_a = static_cast<std::uint32_t>(i);
+    m.T_a_b = (i % 2 == 0 ? shifted : truth) * Planar(0.01 * i, 0, 0);
+    matches.push_back(m);
+  }
+  RoomMatchConfig config;
+  std::uint32_t keep[8];
+  EXPECT_EQ(ConsistentMatches(matches, config, keep), 0u);
+  // A third match for the truth breaks the tie.
+  RoomMatch third;
+  third.room_a = 9;
+  third.T_a_b = truth;
+  matches.push_back(third);
+  ASSERT_EQ(ConsistentMatches(matches, config, keep), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(matches[keep[i]].room_a % 2, 1u);  // 1, 3 and 9
+}
+
 TEST(RoomMatcher, FineAlignmentRecoversTheMapToMapTransform) {
   // The same room (furnished, so not symmetric) seen by two robots whose maps differ by truth.
   auto room = test::BoxRoom(6, 4, 2.4, 6000, 0.01, 5,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # N msgraphs_node processes, one per simulated robot, on 127.0.0.1 with real Fast DDS: each maps
-# its own recording (pcap + candump, lock-step), they exchange distilled graphs, descriptors and
+# its own recording (pcap + candump), they exchange distilled graphs, descriptors and
 # room clouds, and every robot must place every other one (msgraphs_fleet_ate against the truth).
 #
 #   fleet_processes_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_fleet_ate> <world file> \
@@ -16,6 +16,9 @@ ros_listener=""
 [[ $late == ros=* ]] && { ros_listener=${late#ros=}; late=""; }
 # Late: the first robots stay long enough for the last one to arrive.
 quiet_s=6; [[ $late == late ]] && quiet_s=30
+# Side by side at 4x the recorded pace (robots in the field progress together); the late test
+# replays in lock-step, as fast as possible: the last robot arrives with its whole map.
+pace=recorded; [[ $late == late ]] && pace=lockstep
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 "$sim" --world "$world" --out "$work/run" --robots "$robots" --duration-s 120 \
   --seed 1 --shared-rooms 2 > "$work/sim.log" || { cat "$work/sim.log"; exit 1; }
@@ -29,7 +32,8 @@ pcap = run/robot1/velodyne.pcap
 source = candump
 candump = run/robot1/odometry.log
 [replay]
-pace = lockstep
+pace = $pace
+speed = 4
 [link]
 domain = $domain
 loopback_only = true

@@ -530,7 +530,14 @@ bool CollabSession::Impl::MatchPeer(Peer& p, CollabOutbox& out) {
       continue;
     }
     if (calls - q.requested_call >= config.request_retry_calls) {
-      SendRequest(out, p, q);
+      // Several of our rooms may wait for the same cloud: one request for all of them.
+      bool sent_this_call = false;
+      for (std::size_t k = 0; k < kept; ++k) {
+        const Pending& o = p.pending[k];
+        sent_this_call |= o.peer_room == q.peer_room && o.peer_version == q.peer_version &&
+                          o.requested_call == calls;
+      }
+      if (!sent_this_call) SendRequest(out, p, q);
       q.requested_call = calls;
     }
     p.pending[kept++] = q;

@@ -77,30 +77,18 @@ Status RoomMatcher::FineAlign(std::span<const Eigen::Vector3f> cloud_a,
   return Ok();
 }
 
-std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
-                              const RoomMatchConfig& config,
-                              std::span<std::uint32_t> out) {
-  const std::size_t n = std::min<std::size_t>(matches.size(), 64);
-  std::uint64_t adjacency[64] = {};
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const Eigen::Isometry3d D = matches[i].T_a_b.inverse() * matches[j].T_a_b;
-      const double yaw = std::fabs(std::atan2(D.linear()(1, 0), D.linear()(0, 0)));
-      if (D.translation().head<2>().norm() < config.consistency_translation_m &&
-          yaw < config.consistency_yaw_rad) {
-        adjacency[i] |= 1ull << j;
-        adjacency[j] |= 1ull << i;
-      }
-    }
-  }
-  // Maximum clique by Bron-Kerbosch with pivoting over bit sets (n <= 64, sparse in practice).
+namespace {
+
+// Maximum clique of the agreement graph restricted to `allowed`, by Bron-Kerbosch with pivoting
+// over bit sets (n <= 64, sparse in practice).
+std::uint64_t MaximumClique(const std::uint64_t* adjacency, std::uint64_t allowed) {
   std::uint64_t best = 0;
   struct Frame {
     std::uint64_t r, p, x;
   };
   Frame stack[64 * 2 + 2];
   std::size_t top = 0;
-  stack[top++] = {0, n == 64 ? ~0ull : ((1ull << n) - 1), 0};
+  stack[top++] = {0, allowed, 0};
   while (top > 0) {
     Frame f = stack[--top];
     if (f.p == 0 && f.x == 0) {
@@ -120,6 +108,34 @@ std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
       f.x |= bit;
     }
   }
+  return best;
+}
+
+}  // namespace
+
+std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
+                              const RoomMatchConfig& config,
+                              std::span<std::uint32_t> out) {
+  const std::size_t n = std::min<std::size_t>(matches.size(), 64);
+  std::uint64_t adjacency[64] = {};
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const Eigen::Isometry3d D = matches[i].T_a_b.inverse() * matches[j].T_a_b;
+      const double yaw = std::fabs(std::atan2(D.linear()(1, 0), D.linear()(0, 0)));
+      if (D.translation().head<2>().norm() < config.consistency_translation_m &&
+          yaw < config.consistency_yaw_rad) {
+        adjacency[i] |= 1ull << j;
+        adjacency[j] |= 1ull << i;
+      }
+    }
+  }
+  const std::uint64_t all = n == 64 ? ~0ull : ((1ull << n) - 1);
+  const std::uint64_t best = MaximumClique(adjacency, all);
+  // A tie is no answer: in a symmetric building two hypotheses can each gather the same
+  // number of agreeing matches, and taking the first found merges the maps metres apart.
+  // Wait until one of them has more (a match elsewhere breaks the symmetry).
+  const std::uint64_t rival = MaximumClique(adjacency, all & ~best);
+  if (std::popcount(rival) == std::popcount(best)) return 0;
   if (static_cast<std::size_t>(std::popcount(best)) < config.min_consistent) return 0;
   std::size_t count = 0;
   for (std::size_t i = 0; i < n && count < out.size(); ++i) {

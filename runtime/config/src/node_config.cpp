@@ -3,6 +3,7 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -153,7 +154,7 @@ class Reader {
 };
 
 constexpr const char* kLidarSources[] = {"udp", "pcap"};
-constexpr const char* kOdometrySources[] = {"socketcan", "candump"};
+constexpr const char* kOdometrySources[] = {"socketcan", "candump", "udp"};
 constexpr const char* kPaces[] = {"lockstep", "recorded"};
 constexpr const char* kModes[] = {"rooms", "rooms-fine", "rooms-walls", "rooms-walls-fine"};
 constexpr const char* kClouds[] = {"f32", "q16", "q8"};
@@ -212,6 +213,7 @@ bool ParseNodeConfig(const std::string& text,
   r.Choice("odometry", "source", kOdometrySources, c.odometry_source);
   r.Path("odometry", "candump", c.candump_path);
   r.String("odometry", "interface", c.can_interface);
+  r.Integer("odometry", "udp_port", 0, 65535, c.can_udp_port);
 
   r.Choice("replay", "pace", kPaces, c.pace);
   r.Number("replay", "speed", 0.01, 1000, c.speed);
@@ -233,6 +235,8 @@ bool ParseNodeConfig(const std::string& text,
   r.Float("collab", "cloud_step_m", 0.001, 0.1, c.collab.cloud_step_m);
   r.Integer("collab", "max_peers", 1, 64, c.collab.max_peers);
   r.Number("collab", "exchange_period_s", 0.5, 600, c.exchange_period_s);
+  r.Number("collab", "match_period_s", 0.05, 60, c.match_period_s);
+  r.Number("collab", "request_retry_s", 0.5, 600, c.request_retry_s);
   r.Bool("collab", "feedback", c.feedback);
 
   link::DdsSettings& dds = c.link.dds;
@@ -297,6 +301,9 @@ bool ParseNodeConfig(const std::string& text,
   if (!c.led_line.empty() && c.led_chip.empty()) return fail("[led] line needs chip");
   if (!c.led_chip.empty() && c.led_line.empty()) return fail("[led] chip needs line");
   c.collab.robot = c.robot.value;
+  // The session counts Match calls, not seconds (core has no clock).
+  c.collab.request_retry_calls =
+      static_cast<std::uint32_t>(std::max(1.0, std::ceil(c.request_retry_s / c.match_period_s)));
   if (Status s = c.link.Validate(); !s) return fail(std::string("[link] ") + s.error().detail);
   if (Status s = c.mapper.Validate(); !s) return fail(std::string("[mapping] ") + s.error().detail);
   if (Status s = c.collab.Validate(); !s) return fail(std::string("[collab] ") + s.error().detail);

@@ -34,6 +34,9 @@ void Node::Impl::CollabLoop() {
   std::map<std::uint16_t, std::uint64_t> gaps_seen;
   SteadyTime last_resend;
   bool resent_once = false;
+  const Duration match_period = Duration::FromSeconds(config.match_period_s);
+  SteadyTime next_match = platform::SteadyNow();
+  bool pending_change = false;  // received since the last Match
 
   while (!ShouldStop()) {
     std::size_t received = 0;
@@ -55,10 +58,16 @@ void Node::Impl::CollabLoop() {
         ++received;
       } while (received < kMessagesPerRound && link->Receive(message, Duration()));
     }
+    pending_change = pending_change || changed;
     bool origins_changed = false;
-    {
+    const SteadyTime before_match = platform::SteadyNow();
+    // Match on a fixed period: its call count is the session's clock for request retries.
+    if (before_match >= next_match) {
+      next_match = before_match + match_period;
       std::lock_guard<std::mutex> lock(session_mutex);
       origins_changed = session.Match(*link);
+      changed = pending_change;
+      pending_change = false;
       if ((changed || origins_changed) && config.feedback) {
         // The priors are recomputed whenever a peer's walls or an origin moved; the SLAM
         // thread takes the newest at its next exchange.

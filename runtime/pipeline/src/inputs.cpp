@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "msgraphs/base/ipv4.hpp"
+#include "msgraphs/drivers/can_odometry/candump.hpp"
 #include "msgraphs/drivers/can_odometry/candump_file.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/can_odometry/socketcan.hpp"
@@ -12,6 +13,7 @@
 #include "msgraphs/drivers/velodyne/velodyne_source.hpp"
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/realtime.hpp"
+#include "msgraphs/platform/udp_socket.hpp"
 #include "node_impl.hpp"
 
 namespace msgraphs::runtime {
@@ -197,6 +199,41 @@ void Node::Impl::OdometryLoop() {
       add(line.frame, line.stamp);
     }
     odometry_counters.rejected.fetch_add(reader->stats().malformed, std::memory_order_relaxed);
+    odometry.Close();
+    return;
+  }
+
+  if (config.odometry_source == config::OdometrySource::kUdp) {
+    // One candump line per datagram; the line's own stamp is the recording's: arrival counts.
+    platform::UdpReceiverConfig udp_config;
+    if (auto bind = ParseIpv4Address(config.bind_address.c_str())) udp_config.bind.address = *bind;
+    udp_config.bind.port = config.can_udp_port;
+    udp_config.max_payload_bytes = drivers::can_odometry::kMaxCandumpLine;
+    udp_config.receive_buffer_bytes = 1 << 20;
+    auto udp = platform::UdpReceiver::Open(udp_config);
+    if (!udp) {
+      odometry_counters.Fail(std::string("cannot open the CAN-over-UDP port: ") +
+                             udp.error().detail);
+      odometry.Close();
+      return;
+    }
+    while (!ShouldStop()) {
+      auto n = udp->Receive(platform::SteadyNow() + kPollSlice);
+      if (!n) {
+        odometry_counters.Fail(std::string("CAN-over-UDP receive failed: ") + n.error().detail);
+        break;
+      }
+      for (std::size_t i = 0; i < *n; ++i) {
+        const platform::ReceivedDatagram& d = udp->datagram(i);
+        auto line = drivers::can_odometry::ParseCandumpLine(
+            {reinterpret_cast<const char*>(d.payload.data()), d.payload.size()});
+        if (!line || line->kind != drivers::can_odometry::CandumpLine::Kind::kFrame) {
+          odometry_counters.rejected.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
+        add(line->frame, d.kernel_time);
+      }
+    }
     odometry.Close();
     return;
   }

@@ -254,7 +254,9 @@ int Node::Run(const std::atomic<bool>& stop) {
               c.robot.value, c.name.c_str(),
               c.lidar_source == config::LidarSource::kPcap ? c.pcap_path.c_str() : "Velodyne UDP",
               c.odometry_source == config::OdometrySource::kCandump ? c.candump_path.c_str()
-                                                                    : c.can_interface.c_str(),
+              : c.odometry_source == config::OdometrySource::kUdp
+                  ? ("CAN over UDP port " + std::to_string(c.can_udp_port)).c_str()
+                  : ("SocketCAN " + c.can_interface).c_str(),
               PaceName(c));
   std::printf("  DDS domain %u%s, discovery %s, radio cap %s, exchange every %.1f s\n",
               c.link.dds.domain_id, c.link.dds.loopback_only ? " (127.0.0.1 only)" : "",

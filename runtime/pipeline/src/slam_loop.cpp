@@ -113,8 +113,12 @@ void Node::Impl::SlamLoop() {
     const double needed_s = scan->end_s + kOdometryMargin_s;
     drain_odometry(lockstep() ? needed_s + 0.05 : inf);
     if (mapper.odometry().newest_stamp() < needed_s && !odometry_ended()) {
-      const bool patient =
-          lockstep() || platform::SteadyNow() - scan->last_packet < kOdometryPatience;
+      // A scan older than every odometry sample kept will never be covered: no use waiting.
+      const auto start_pose = mapper.odometry().At(scan->start_s);
+      const bool hopeless =
+          mapper.odometry().size() > 0 && !start_pose && start_pose.error().code == Errc::kNotFound;
+      const bool patient = !hopeless && (lockstep() || platform::SteadyNow() - scan->last_packet <
+                                                           kOdometryPatience);
       if (patient) {
         static_cast<void>(odometry.Front(kWait));
         continue;

@@ -13,7 +13,8 @@
 //   maximum clique is kept and everything else is rejected. Identical rooms of a symmetric
 //   building each align perfectly but to different transforms, so they do not agree with the
 //   true matches. A clique smaller than `min_consistent` keeps nothing (one match alone cannot be
-//   checked).
+//   checked), and so does a tie: when another set of matches, disjoint from the largest, is as
+//   large, the building's symmetry has not been broken yet.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -85,7 +86,8 @@ Eigen::Isometry3d MatchFromRoomFrames(const Eigen::Isometry3d& T_mapa_rooma,
                                       double yaw_rad);
 
 /// Indices of the largest set of mutually consistent matches (all between the same two robots);
-/// empty when it is smaller than config.min_consistent. At most 64 matches are considered.
+/// empty when it is smaller than config.min_consistent or when a disjoint set is as large (two
+/// hypotheses, no answer yet). At most 64 matches are considered.
 std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
                               const RoomMatchConfig& config,
                               std::span<std::uint32_t> out);

@@ -13,12 +13,14 @@
 #include "msgraphs/base/node_key.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/slam/local_mapper.hpp"
-#include "msgraphs/runtime/link/fleet_link.hpp"
+#include "msgraphs/runtime/link/link_settings.hpp"
 
 namespace msgraphs::runtime::config {
 
 enum class LidarSource : std::uint8_t { kUdp, kPcap };
-enum class OdometrySource : std::uint8_t { kSocketCan, kCandump };
+/// kUdp: CAN frames as candump lines, one per UDP datagram (a CAN-to-Ethernet gateway, or
+/// msgraphs_replay --candump), stamped by their arrival like live SocketCAN frames.
+enum class OdometrySource : std::uint8_t { kSocketCan, kCandump, kUdp };
 /// Recorded inputs: kLockstep as fast as the SLAM thread takes them (nothing is dropped, the
 /// readers wait); kRecorded at the recorded pace times `speed` (queues overflow as they would
 /// live, and count it).
@@ -42,6 +44,7 @@ struct NodeConfig {
   OdometrySource odometry_source = OdometrySource::kSocketCan;
   std::string candump_path;
   std::string can_interface = "can0";
+  std::uint16_t can_udp_port = 20000;  ///< kUdp
 
   // [replay]
   Pace pace = Pace::kRecorded;
@@ -53,7 +56,11 @@ struct NodeConfig {
   // [collab]
   core::CollabSessionConfig collab;
   double exchange_period_s = 10.0;  ///< sensor time between two Publish calls
-  bool feedback = true;             ///< other robots' walls into the local S-Graph
+  /// Wall time between two CollabSession::Match calls, and before an unanswered room cloud
+  /// request is sent again (a capped radio may take seconds to deliver a cloud).
+  double match_period_s = 0.5;
+  double request_retry_s = 10.0;
+  bool feedback = true;  ///< other robots' walls into the local S-Graph
 
   // [link]
   link::LinkSettings link;
@@ -63,7 +70,7 @@ struct NodeConfig {
   int realtime_priority = 0;  ///< SCHED_FIFO priority of the sensor threads; 0: normal
   bool lock_memory = false;
   double status_period_s = 5.0;
-  std::size_t scan_queue = 4;         ///< assembled scans waiting for SLAM
+  std::size_t scan_queue = 8;         ///< assembled scans waiting for SLAM
   std::size_t odometry_queue = 4096;  ///< odometry samples waiting for SLAM
   /// After the inputs end (recordings) and every peer heard has ended too, keep exchanging
   /// this long, then exit; 0: run until a signal.

@@ -44,26 +44,9 @@
 #include "msgraphs/base/node_key.hpp"
 #include "msgraphs/base/time.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
-#include "msgraphs/runtime/link/dds_settings.hpp"
+#include "msgraphs/runtime/link/link_settings.hpp"
 
 namespace msgraphs::runtime::link {
-
-/// The largest payloads the IDL admits (CollabMessages.idl), by core::CollabMessageType.
-inline constexpr std::array<std::size_t, core::kCollabMessageTypes> kMaxPayloadBytes = {
-    262144, 8192, 64, 1048576};
-
-struct LinkSettings {
-  DdsSettings dds;
-  /// Radio budget of this robot (all topics); 0: no cap.
-  std::uint32_t max_bytes_per_s = 0;
-  /// Distilled deltas a writer keeps for late joiners.
-  std::uint32_t graph_history = 64;
-  /// Samples per topic a reader holds for the node before back-pressure.
-  std::uint32_t reader_depth = 256;
-  /// Payloads above this are refused (per type, at most kMaxPayloadBytes).
-  std::array<std::size_t, core::kCollabMessageTypes> max_payload_bytes = kMaxPayloadBytes;
-  Status Validate() const;
-};
 
 enum class NodeState : std::uint8_t { kStarting, kMapping, kInputDone, kStopping };
 const char* ToString(NodeState state);
@@ -108,6 +91,11 @@ struct LinkStats {
   std::array<TopicStats, core::kCollabMessageTypes + 1> topics{};
   std::uint64_t robots_appeared = 0, robots_vanished = 0;
 };
+
+/// Makes participants of this process talk through the network stack as separate processes do
+/// (Fast DDS otherwise short-cuts them in memory): for the self-check's latency figures. Call
+/// before the first Create.
+void DisableIntraprocessDelivery();
 
 class FleetLink final : public core::CollabOutbox {
  public:
