@@ -4,9 +4,13 @@
 # pace; both streams are stamped on arrival, as live ones are. The node must map the mission:
 # its keyframes, brought back to the recording's clock, against the simulator's truth. Stopped
 # with SIGTERM once the replay ends.
-#   hil_replay_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_replay> <msgraphs_ate> <world> <domain>
+#   hil_replay_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_replay> <msgraphs_ate> <world> <domain> [restart]
+#
+# "restart": the node keeps a checkpoint and is killed (SIGKILL) 15 s into the replay, then
+# started again at once while the replay goes on: it must resume its map from the journal,
+# re-anchor the restarted odometry integration on it and keep mapping to the same accuracy.
 set -u
-node=$1; sim=$2; replay=$3; ate=$4; world=$5; domain=$6
+node=$1; sim=$2; replay=$3; ate=$4; world=$5; domain=$6; restart=${7:-}
 work=$(mktemp -d); trap 'for p in $(jobs -p); do kill -9 $p 2>/dev/null; done; rm -rf "$work"' EXIT
 "$sim" --world "$world" --out "$work/run" --robots 1 --duration-s 40 --seed 5 > /dev/null || exit 1
 base=$(( 23000 + domain * 4 ))
@@ -26,6 +30,8 @@ domain = $domain
 loopback_only = true
 [runtime]
 status_period_s = 5
+[checkpoint]
+dir = checkpoint
 [output]
 dir = out
 CONF
@@ -34,7 +40,16 @@ pid=$!
 sleep 1
 "$replay" --pcap "$work/run/robot1/velodyne.pcap" --candump "$work/run/robot1/odometry.log" \
   --to 127.0.0.1 --data-port $base --position-port $(( base + 1 )) --can-port $(( base + 2 )) \
-  > "$work/replay.log" 2>&1 || { cat "$work/replay.log"; exit 1; }
+  > "$work/replay.log" 2>&1 &
+replay_pid=$!
+if [[ $restart == restart ]]; then
+  sleep 15
+  kill -9 $pid; wait $pid 2>/dev/null
+  echo "node killed (SIGKILL) 15 s into the replay; restarted"
+  "$node" --config "$work/robot.conf" >> "$work/node.log" 2>&1 &
+  pid=$!
+fi
+wait $replay_pid || { cat "$work/replay.log"; exit 1; }
 sleep 2
 kill -TERM $pid
 wait $pid; code=$?
@@ -43,6 +58,9 @@ grep "^\[robot" "$work/node.log" | tail -2 | cut -c1-200
 sed -n '/report:/,$p' "$work/node.log" | grep -E "report|queues|latency"
 rc=0
 [[ $code -eq 0 ]] || { echo "node exit $code"; rc=1; }
+if [[ $restart == restart ]]; then
+  grep "resumed from checkpoint" "$work/node.log" || { echo "the node did not resume"; rc=1; }
+fi
 # The node stamps by arrival: shift its keyframes back by the replay's anchor.
 offset=$(grep -o "recording time [0-9.]* is sent at host time [0-9.]*" "$work/replay.log" |
          awk '{ printf "%.6f", $9 - $3 }')

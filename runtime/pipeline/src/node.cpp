@@ -35,6 +35,7 @@ class Restore final : public JournalSink {
       : mapper_(mapper), session_(session) {}
   void OnOdometry(double stamp_s, const Eigen::Isometry3d& T) override {
     static_cast<void>(mapper_.AddOdometry(stamp_s, T));
+    last_odometry = T;
   }
   void OnScan(std::span<const Eigen::Vector3f> points,
               std::span<const float> times,
@@ -49,6 +50,7 @@ class Restore final : public JournalSink {
   void OnMessage(core::CollabMessageType type, std::span<const std::uint8_t> bytes) override {
     static_cast<void>(session_.Receive(type, bytes, outbox_));
   }
+  Eigen::Isometry3d last_odometry = Eigen::Isometry3d::Identity();  ///< odometry frame, newest
 
  private:
   core::LocalMapper& mapper_;
@@ -123,6 +125,13 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
           replay->stopped.empty() ? "" : "; stopped early: ", replay->stopped.c_str());
       m.resume_scans_after_s = replay->last_scan_end_s;
       m.resume_odometry_after_s = replay->last_odometry_s;
+      // Live odometry restarts its integration at identity: the SLAM thread re-anchors the new
+      // odometry frame on the last journaled pose (as if the robot had not moved while the node
+      // was down; scan matching takes up what it did move, within max_correction_m).
+      if (config.odometry_source != config::OdometrySource::kCandump) {
+        m.reanchor_odometry = true;
+        m.T_old_last = restore.last_odometry;
+      }
       std::lock_guard<std::mutex> lock(m.status_mutex);
       m.slam_status.keyframes = m.mapper.stats().keyframes;
     }

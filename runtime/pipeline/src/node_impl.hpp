@@ -143,6 +143,11 @@ struct Node::Impl {
   std::atomic<std::uint64_t> journal_errors{0};
   /// Restored from the journal: recorded inputs skip what is already in the map.
   double resume_scans_after_s = -1, resume_odometry_after_s = -1;
+  /// Live inputs after a resume: new odometry is mapped into the journal's odometry frame by
+  /// T_odom_fix = T_old_last * T_new_first^-1, fixed at the first new sample (SLAM thread).
+  bool reanchor_odometry = false;
+  Eigen::Isometry3d T_old_last = Eigen::Isometry3d::Identity();
+  std::optional<Eigen::Isometry3d> T_odom_fix;
   void Journal(auto&& write) {
     if (!journal) return;
     std::lock_guard<std::mutex> lock(journal_mutex);

@@ -94,10 +94,14 @@ void Node::Impl::SlamLoop() {
   auto drain_odometry = [&](double horizon_s) {
     while (OdometrySlot* o = odometry.Front(Duration())) {
       if (o->stamp_s > horizon_s) break;
-      static_cast<void>(mapper.AddOdometry(o->stamp_s, o->T_odom_base));
-      Journal([&](JournalWriter& j) {
-        return static_cast<bool>(j.Odometry(o->stamp_s, o->T_odom_base));
-      });
+      Eigen::Isometry3d T_odom_base = o->T_odom_base;
+      if (reanchor_odometry) {
+        if (!T_odom_fix) T_odom_fix = T_old_last * o->T_odom_base.inverse();
+        T_odom_base = *T_odom_fix * o->T_odom_base;
+      }
+      static_cast<void>(mapper.AddOdometry(o->stamp_s, T_odom_base));
+      Journal(
+          [&](JournalWriter& j) { return static_cast<bool>(j.Odometry(o->stamp_s, T_odom_base)); });
       odometry.Pop();
     }
   };
