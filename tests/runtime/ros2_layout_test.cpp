@@ -96,7 +96,9 @@ class ReferenceCdr {
     else if (t == "uint8")
       Put<std::uint8_t>(static_cast<std::uint8_t>(c));
     else if (t == "string") {
-      const std::string s = "s" + std::to_string(c);
+      // Built by append: GCC 12's -Wrestrict misfires on "s" + std::to_string(c) at -O3.
+      std::string s = "s";
+      s += std::to_string(c);
       Put<std::uint32_t>(static_cast<std::uint32_t>(s.size() + 1));
       bytes.insert(bytes.end(), s.begin(), s.end());
       bytes.push_back(0);
@@ -116,7 +118,11 @@ struct Fill {
   double D() { return counter++ + 0.25; }
   bool B() { return counter++ % 2 != 0; }
   std::uint8_t O() { return static_cast<std::uint8_t>(counter++); }
-  std::string S() { return "s" + std::to_string(counter++); }
+  std::string S() {
+    std::string s = "s";
+    s += std::to_string(counter++);
+    return s;
+  }
 
   void Header(std_msgs::msg::Header& h) {
     h.stamp().sec(I());
