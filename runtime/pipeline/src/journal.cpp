@@ -137,7 +137,8 @@ JournalWriter::~JournalWriter() {
 Status JournalWriter::Write(JournalRecord type, std::span<const std::uint8_t> payload) {
   // Header and payload in one buffer and one write(): a killed process leaves whole records.
   record_.resize(kRecordHeader + payload.size());
-  std::memcpy(record_.data() + kRecordHeader, payload.data(), payload.size());
+  if (!payload.empty())  // an empty span's data() may be null, which memcpy may not take
+    std::memcpy(record_.data() + kRecordHeader, payload.data(), payload.size());
   // The CRC covers the type and the payload: put the type just before the payload (in the CRC
   // field, overwritten next) to checksum them in one pass.
   record_[kRecordHeader - 1] = static_cast<std::uint8_t>(type);
