@@ -241,6 +241,62 @@ TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
   EXPECT_TRUE(g.has_floor());
 }
 
+TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
+  // A node killed at step 11 of the walk and restarted at step 14: its odometry integration
+  // begins again at identity, 2 m and 80 degrees of turning away from where the map stopped.
+  const LocalMapperConfig config = SmallConfig(64, 256);
+  LocalMapper mapper;
+  ASSERT_TRUE(mapper.Init(config));
+  const Walk walk;
+  std::vector<float> times(20000, 0.1f);
+  for (std::size_t i = 0; i <= 11; ++i) {
+    const double t = 10.0 + static_cast<double>(i);
+    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
+    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
+    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
+    ASSERT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
+  }
+  const SGraph& g = mapper.graph();
+  const std::uint32_t last = static_cast<std::uint32_t>(g.keyframe_slots() - 1);
+  const Eigen::Isometry3d T_map_odom = g.keyframe_pose(last) * mapper.keyframe_odometry(last).inverse();
+  // Where the node stopped, and where it would be had it kept its last step's motion three
+  // more steps, times 1.5 (the caller's prediction over the downtime).
+  RelocaliseSearch search;
+  search.T_odom_from = walk.odometry[11];
+  const Eigen::Isometry3d step = walk.odometry[10].inverse() * walk.odometry[11];
+  Eigen::Isometry3d ahead = walk.odometry[11];
+  for (int k = 0; k < 4; ++k) ahead = ahead * step;
+  search.T_odom_to = ahead;
+  const auto points = ScanAt(walk.truth[14], config, 15);
+  const Eigen::Isometry3d T_new = Eigen::Isometry3d::Identity();  // the new integration
+  test::AllocationScope scope;
+  auto reloc = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search);
+  EXPECT_EQ(scope.allocations(), 0u);
+  ASSERT_TRUE(reloc) << reloc.error().detail;
+  const Eigen::Isometry3d found = T_map_odom * reloc->T_odom_base;
+  EXPECT_LT((found.translation() - walk.truth[14].translation()).norm(), 0.05);
+  EXPECT_LT(Eigen::AngleAxisd(found.linear().transpose() * walk.truth[14].linear()).angle(), 0.01);
+  EXPECT_GT(reloc->candidates, 100u);
+  EXPECT_LE(reloc->registrations, search.registrations);
+  EXPECT_LT(reloc->fitness_m2, config.scan_match_max_fitness_m2);
+  // The map is untouched: same keyframes, same last pose.
+  EXPECT_EQ(g.keyframe_slots(), last + 1);
+  // Searching only where the robot is not (the stop point, no span, no sides or turns) fails.
+  RelocaliseSearch narrow;
+  narrow.T_odom_from = narrow.T_odom_to = walk.odometry[11];
+  narrow.lateral_m = 0;
+  narrow.yaw_rad = 0;
+  narrow.registrations = 1;
+  auto miss = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, narrow);
+  ASSERT_FALSE(miss);
+  EXPECT_EQ(miss.error().code, Errc::kNotConverged);
+  // Without a keyframe there is nothing to relocalise against.
+  LocalMapper empty;
+  ASSERT_TRUE(empty.Init(config));
+  EXPECT_EQ(empty.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search).error().code,
+            Errc::kNotFound);
+}
+
 TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {
   const LocalMapperConfig config = SmallConfig(32, 128);
   LocalMapper mapper;

@@ -7,8 +7,9 @@
 #   hil_replay_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_replay> <msgraphs_ate> <world> <domain> [restart]
 #
 # "restart": the node keeps a checkpoint and is killed (SIGKILL) 15 s into the replay, then
-# started again at once while the replay goes on: it must resume its map from the journal,
-# re-anchor the restarted odometry integration on it and keep mapping to the same accuracy.
+# started again 3 s later while the replay (the robot) goes on: it must resume its map from the
+# journal, relocalise its first scan against it (the restarted odometry integration begins at
+# identity, metres from where the journal stopped) and keep mapping to the same accuracy.
 set -u
 node=$1; sim=$2; replay=$3; ate=$4; world=$5; domain=$6; restart=${7:-}
 work=$(mktemp -d); trap 'for p in $(jobs -p); do kill -9 $p 2>/dev/null; done; rm -rf "$work"' EXIT
@@ -45,7 +46,8 @@ replay_pid=$!
 if [[ $restart == restart ]]; then
   sleep 15
   kill -9 $pid; wait $pid 2>/dev/null
-  echo "node killed (SIGKILL) 15 s into the replay; restarted"
+  sleep 3  # down for a while: the robot walks on, metres from where the journal stopped
+  echo "node killed (SIGKILL) 15 s into the replay; restarted 3 s later"
   "$node" --config "$work/robot.conf" >> "$work/node.log" 2>&1 &
   pid=$!
 fi
@@ -60,6 +62,7 @@ rc=0
 [[ $code -eq 0 ]] || { echo "node exit $code"; rc=1; }
 if [[ $restart == restart ]]; then
   grep "resumed from checkpoint" "$work/node.log" || { echo "the node did not resume"; rc=1; }
+  grep "relocalised after the restart" "$work/node.log" || { echo "no relocalisation"; rc=1; }
 fi
 # The node stamps by arrival: shift its keyframes back by the replay's anchor.
 offset=$(grep -o "recording time [0-9.]* is sent at host time [0-9.]*" "$work/replay.log" |

@@ -15,7 +15,8 @@
 //
 //   msgraphs_collab --run DIR [--mode rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes]
 //                   [--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off]
-//                   [--exchange-every-s 10] [--out DIR] [--markdown]
+//                   [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]... [--hypotheses walls|count]
+//                   [--out DIR] [--markdown]
 //
 // --feedback on (the default) gives each robot's local S-Graph the other robots' measurements of
 // its matched walls, through the merged origins (CollabSession::PlanePriors).
@@ -78,6 +79,7 @@ struct Robot {
   bool odometry_done = false, scans_done = false;
   const drivers::velodyne::Scan* pending = nullptr;
   double first_stamp = -1;
+  double delay_s = 0;  // --delay-s: this robot's mission starts this much later
   core::LocalMapper mapper;
   core::CollabSession session;
   // Baseline: keyframe descriptors (own), and those received with the sender's pose at the time;
@@ -95,7 +97,9 @@ struct Robot {
 };
 
 double Now(const Robot& r) {
-  return r.pending == nullptr ? 1e300 : r.pending->end_time.seconds_since_epoch() - r.first_stamp;
+  return r.pending == nullptr
+             ? 1e300
+             : r.pending->end_time.seconds_since_epoch() - r.first_stamp + r.delay_s;
 }
 
 void Advance(Robot& r) {
@@ -344,6 +348,7 @@ int main(int argc, char** argv) {
   core::CollabSessionConfig session_config;
   std::string mode_name = "rooms-walls-fine";
   double every_s = 10.0;
+  std::map<int, double> delays_s;  // robot id -> start delay
   bool markdown = false, step_given = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -351,6 +356,25 @@ int main(int argc, char** argv) {
       run = argv[++i];
     else if (a == "--exchange-every-s" && i + 1 < argc)
       every_s = std::atof(argv[++i]);
+    else if (a == "--hypotheses" && i + 1 < argc) {
+      // walls (the default): competing match sets told apart by the walls; count: by size alone.
+      const std::string h = argv[++i];
+      if (h != "walls" && h != "count") {
+        std::fprintf(stderr, "collab: --hypotheses takes walls or count\n");
+        return 2;
+      }
+      session_config.hypotheses.use_walls = h == "walls";
+    } else if (a == "--delay-s" && i + 1 < argc) {
+      // ROBOT=SECONDS: that robot starts later in mission time (a late joiner when longer than
+      // the others' missions: it arrives with its whole map).
+      int robot = 0;
+      double delay = 0;
+      if (std::sscanf(argv[++i], "%d=%lf", &robot, &delay) != 2 || robot < 1 || !(delay >= 0)) {
+        std::fprintf(stderr, "collab: --delay-s takes ROBOT=SECONDS\n");
+        return 2;
+      }
+      delays_s[robot] = delay;
+    }
     else if (a == "--markdown")
       markdown = true;
     else if (a == "--out" && i + 1 < argc)
@@ -397,6 +421,7 @@ int main(int argc, char** argv) {
           "usage: msgraphs_collab --run DIR [--mode "
           "rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes] "
           "[--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off] [--exchange-every-s 10] "
+          "[--delay-s ROBOT=SECONDS]... [--hypotheses walls|count] "
           "[--out DIR] "
           "[--markdown]\n");
       return 2;
@@ -433,6 +458,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     r->truth = tools::ReadTum((dir / "ground_truth.tum").string());
+    if (auto d = delays_s.find(r->id()); d != delays_s.end()) r->delay_s = d->second;
     Advance(*r);
     mission.robots.push_back(std::move(r));
   }
@@ -456,7 +482,8 @@ int main(int argc, char** argv) {
       timeline.push_back({t, {}});
       for (int k = 0; k < kMessageTypes; ++k)
         timeline.back().second[static_cast<std::size_t>(k)] = mission.accounting.Total(k);
-      next_exchange += every_s;
+      // The next period after t (a delayed robot can leave a gap of several periods).
+      next_exchange = (std::floor(t / every_s) + 1) * every_s;
     }
     ProcessScan(*next);
   }
@@ -522,6 +549,7 @@ int main(int argc, char** argv) {
     }
   }
   // Accepted matches (consistent sets) of every robot, checked against the truth.
+  std::map<std::pair<int, int>, int> wrong_in_view;  // (viewer, peer) -> wrong accepted matches
   for (auto& r : mission.robots) {
     for (auto& b : mission.robots) {
       if (b == r) continue;
@@ -530,8 +558,10 @@ int main(int argc, char** argv) {
                                         T_world_map[static_cast<std::size_t>(b->index)];
         const Eigen::Isometry3d e = truth.inverse() * m.T_a_b;
         ++accepted;
-        if (e.translation().head<2>().norm() > 0.5 || Eigen::AngleAxisd(e.linear()).angle() > 0.1)
+        if (e.translation().head<2>().norm() > 0.5 || Eigen::AngleAxisd(e.linear()).angle() > 0.1) {
           ++wrong;
+          ++wrong_in_view[{r->id(), b->id()}];
+        }
       }
     }
   }
@@ -590,6 +620,21 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(rejected_anchored),
       static_cast<unsigned long long>(rejected_consistency),
       static_cast<unsigned long long>(accepted), static_cast<unsigned long long>(wrong));
+  // Every robot's view of every other: where competing hypotheses were weighed by the walls, or
+  // where a pair stayed unmerged.
+  for (auto& r : mission.robots) {
+    if (mission.keyframes) break;
+    for (std::size_t i = 0; i < r->session.peers(); ++i) {
+      const core::CollabPeerStats p = r->session.peer_stats(i);
+      const int wrong_here = wrong_in_view[{r->id(), p.robot}];
+      if (p.hypotheses < 2 && p.merged && wrong_here == 0) continue;
+      std::printf("  view of robot %d: robot %u %s, %zu hypotheses%s (%zu matches, walls agree "
+                  "%.1f m; best rival %zu matches, %.1f m); %d accepted matches wrong\n",
+                  r->index + 1, p.robot, p.merged ? "merged" : "NOT merged", p.hypotheses,
+                  p.undecided ? ", undecided" : "", p.hypothesis_matches[0], p.agreement_m[0],
+                  p.hypothesis_matches[1], p.agreement_m[1], wrong_here);
+    }
+  }
   std::printf("data exchanged: %.3f MB in total, %llu messages malformed\n", mb,
               static_cast<unsigned long long>(mission.accounting.malformed));
   for (int t = 0; t < kMessageTypes; ++t) {

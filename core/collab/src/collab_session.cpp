@@ -2,6 +2,7 @@
 #include "msgraphs/core/collab/collab_session.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -13,6 +14,9 @@ namespace {
 
 constexpr std::uint64_t kUntried = std::numeric_limits<std::uint64_t>::max();
 constexpr double kQuarterTurn = 1.5707963267948966;
+// Competing consistent sets of matches compared per peer, largest first, single matches
+// included (a row of identical rooms gives two or three sets and a few single matches).
+constexpr std::size_t kMaxHypotheses = 8;
 
 bool SignificantlyChanged(const DistilledRoom& a, const DistilledRoom& b, double threshold_m) {
   return a.walls != b.walls || a.shape != b.shape || (a.centre - b.centre).norm() > threshold_m ||
@@ -75,6 +79,7 @@ Status CollabSessionConfig::Validate() const {
   if (auto s = distiller.Validate(); !s) return s;
   if (auto s = descriptor.Validate(); !s) return s;
   if (auto s = matcher.Validate(); !s) return s;
+  if (auto s = hypotheses.Validate(); !s) return s;
   return graph.Validate();
 }
 
@@ -113,6 +118,10 @@ struct CollabSession::Impl {
     BoundedVector<RoomMatch> matches;
     std::vector<std::uint32_t> consistent;
     std::size_t consistent_count = 0;
+    std::size_t hypotheses = 0;  // competing consistent sets at the last solve
+    bool undecided = false;      // ... and none clearly better
+    double agreement_m[2] = {};  // wall agreement of the chosen set and of its best rival
+    std::size_t hypothesis_matches[2] = {};  // and their sizes
     bool merged = false;
     std::uint32_t solved_version = 0;  // its graph's version at the last solve
     Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();
@@ -156,6 +165,8 @@ struct CollabSession::Impl {
       p.pending.clear();
       p.matches.clear();
       p.consistent_count = 0;
+      p.hypotheses = 0;
+      p.undecided = false;
       p.merged = false;
       std::fill(p.tried.begin(), p.tried.end(), kUntried);
       p.stats = CollabPeerStats{};
@@ -239,6 +250,8 @@ struct CollabSession::Impl {
   }
 
   bool MatchPeer(Peer& p, CollabOutbox& out);
+  // The accepted set of p's matches into p.consistent (MatchHypotheses, ChooseHypothesis).
+  std::size_t ChooseConsistent(Peer& p, const DistilledGraph& mine);
   void Solve();
 };
 
@@ -623,25 +636,71 @@ bool CollabSession::Impl::MatchPeer(Peer& p, CollabOutbox& out) {
   return changed;
 }
 
+std::size_t CollabSession::Impl::ChooseConsistent(Peer& p, const DistilledGraph& mine) {
+  std::uint64_t sets[kMaxHypotheses] = {};
+  // Single matches too: they cannot be accepted alone, but their walls can veto a set.
+  const std::size_t found = MatchHypotheses(p.matches.span(), config.matcher, 1, sets);
+  p.hypotheses = found;
+  if (found == 0) return 0;
+  std::size_t counts[kMaxHypotheses] = {};
+  double agreement_m[kMaxHypotheses] = {};
+  for (std::size_t h = 0; h < found; ++h) {
+    counts[h] = static_cast<std::size_t>(std::popcount(sets[h]));
+    // The hypothesis's transform: its best fine alignment (any member when none is fine).
+    const RoomMatch* pick = nullptr;
+    for (std::uint32_t i = 0; i < p.matches.size(); ++i) {
+      if (!((sets[h] >> i) & 1ull)) continue;
+      const RoomMatch& m = p.matches[i];
+      if (pick == nullptr || (m.fine_aligned && (!pick->fine_aligned || m.fitness_m2 < pick->fitness_m2)))
+        pick = &m;
+    }
+    agreement_m[h] = config.hypotheses.use_walls
+                         ? WallAgreement_m(mine, p.graph, pick->T_a_b, config.hypotheses)
+                         : 0.0;
+  }
+  const int chosen = ChooseHypothesis(std::span(counts, found), std::span(agreement_m, found),
+                                      config.matcher.min_consistent, config.hypotheses);
+  // Undecided: a set large enough to accept, but a rival as good (a tie, or better walls).
+  p.undecided = chosen < 0 && counts[0] >= config.matcher.min_consistent;
+  // For the report: the chosen set's (or the first's) wall agreement and the best rival's.
+  const std::size_t shown = chosen < 0 ? 0 : static_cast<std::size_t>(chosen);
+  p.agreement_m[0] = agreement_m[shown];
+  p.agreement_m[1] = 0;
+  p.hypothesis_matches[0] = counts[shown];
+  p.hypothesis_matches[1] = 0;
+  for (std::size_t h = 0; h < found; ++h) {
+    if (h == shown || agreement_m[h] < p.agreement_m[1]) continue;
+    p.agreement_m[1] = agreement_m[h];
+    p.hypothesis_matches[1] = counts[h];
+  }
+  stats.undecided += p.undecided ? 1u : 0u;
+  if (chosen < 0) return 0;
+  return HypothesisMembers(sets[chosen],
+                           std::span<std::uint32_t>(p.consistent.data(), p.consistent.size()));
+}
+
 void CollabSession::Impl::Solve() {
   graph.Clear();
   wall_pairs.clear();
-  stats.accepted = stats.rejected_consistency = 0;
+  stats.accepted = stats.rejected_consistency = stats.undecided = 0;
   stats.graph_refused = 0;
   const DistilledGraph& mine = distiller.graph();
   for (Peer& p : peers) {
     if (!p.used) continue;
-    p.consistent_count = ::msgraphs::core::ConsistentMatches(
-        p.matches.span(), config.matcher,
-        std::span<std::uint32_t>(p.consistent.data(), p.consistent.size()));
+    p.consistent_count = ChooseConsistent(p, mine);
     stats.accepted += p.consistent_count;
     stats.rejected_consistency += p.matches.size() - p.consistent_count;
     if (p.consistent_count == 0) {
       p.merged = false;
       continue;
     }
-    // Start from the previous estimate when there is one: the solve then only refines.
-    const Eigen::Isometry3d initial = p.merged ? p.T_self_peer : p.matches[p.consistent[0]].T_a_b;
+    // Start from the previous estimate when it is the same hypothesis: the solve then only
+    // refines. A hypothesis that replaced another starts from its own match.
+    const Eigen::Isometry3d& first = p.matches[p.consistent[0]].T_a_b;
+    const Eigen::Isometry3d e = p.T_self_peer.inverse() * first;
+    const bool same = p.merged && e.translation().head<2>().norm() < config.anchored_translation_m &&
+                      Eigen::AngleAxisd(e.linear()).angle() < config.anchored_rotation_rad;
+    const Eigen::Isometry3d initial = same ? p.T_self_peer : first;
     if (!graph.SetInitial(p.robot, initial)) continue;
     for (std::size_t k = 0; k < p.consistent_count; ++k) {
       const RoomMatch& m = p.matches[p.consistent[k]];
@@ -803,6 +862,12 @@ CollabPeerStats CollabSession::peer_stats(std::size_t index) const {
     s.descriptors = p.rooms.size();
     s.matches = p.matches.size();
     s.consistent = p.consistent_count;
+    s.hypotheses = p.hypotheses;
+    s.undecided = p.undecided;
+    s.agreement_m[0] = p.agreement_m[0];
+    s.agreement_m[1] = p.agreement_m[1];
+    s.hypothesis_matches[0] = p.hypothesis_matches[0];
+    s.hypothesis_matches[1] = p.hypothesis_matches[1];
     return s;
   }
   return {};

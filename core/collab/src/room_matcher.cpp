@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/collab/room_matcher.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <numbers>
@@ -113,9 +114,10 @@ std::uint64_t MaximumClique(const std::uint64_t* adjacency, std::uint64_t allowe
 
 }  // namespace
 
-std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
-                              const RoomMatchConfig& config,
-                              std::span<std::uint32_t> out) {
+std::size_t MatchHypotheses(std::span<const RoomMatch> matches,
+                            const RoomMatchConfig& config,
+                            std::size_t min_matches,
+                            std::span<std::uint64_t> out) {
   const std::size_t n = std::min<std::size_t>(matches.size(), 64);
   std::uint64_t adjacency[64] = {};
   for (std::size_t i = 0; i < n; ++i) {
@@ -129,17 +131,36 @@ std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
       }
     }
   }
-  const std::uint64_t all = n == 64 ? ~0ull : ((1ull << n) - 1);
-  const std::uint64_t best = MaximumClique(adjacency, all);
+  std::uint64_t left = n == 64 ? ~0ull : ((1ull << n) - 1);
+  std::size_t count = 0;
+  while (count < out.size() && left != 0) {
+    const std::uint64_t clique = MaximumClique(adjacency, left);
+    if (static_cast<std::size_t>(std::popcount(clique)) < std::max<std::size_t>(min_matches, 1))
+      break;
+    out[count++] = clique;
+    left &= ~clique;
+  }
+  return count;
+}
+
+std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
+                              const RoomMatchConfig& config,
+                              std::span<std::uint32_t> out) {
+  std::uint64_t hypotheses[2] = {};
+  const std::size_t found = MatchHypotheses(matches, config, config.min_consistent, hypotheses);
+  if (found == 0) return 0;
   // A tie is no answer: in a symmetric building two hypotheses can each gather the same
   // number of agreeing matches, and taking the first found merges the maps metres apart.
-  // Wait until one of them has more (a match elsewhere breaks the symmetry).
-  const std::uint64_t rival = MaximumClique(adjacency, all & ~best);
-  if (std::popcount(rival) == std::popcount(best)) return 0;
-  if (static_cast<std::size_t>(std::popcount(best)) < config.min_consistent) return 0;
+  // Wait until one of them has more (a match elsewhere breaks the symmetry), or let the caller
+  // tell them apart by the rest of the maps (MatchHypotheses, WallAgreement_m).
+  if (found == 2 && std::popcount(hypotheses[1]) == std::popcount(hypotheses[0])) return 0;
+  return HypothesisMembers(hypotheses[0], out);
+}
+
+std::size_t HypothesisMembers(std::uint64_t hypothesis, std::span<std::uint32_t> out) {
   std::size_t count = 0;
-  for (std::size_t i = 0; i < n && count < out.size(); ++i) {
-    if ((best >> i) & 1ull) out[count++] = static_cast<std::uint32_t>(i);
+  for (std::uint32_t i = 0; i < 64 && count < out.size(); ++i) {
+    if ((hypothesis >> i) & 1ull) out[count++] = i;
   }
   return count;
 }

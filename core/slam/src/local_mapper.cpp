@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "msgraphs/core/geometry/se3.hpp"
@@ -88,6 +89,8 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   sequence_.assign(slots, 0);
   keyframe_odometry_.assign(slots, Eigen::Isometry3d::Identity());
   recent_.assign(config.local_map_keyframes, 0);
+  nearby_.assign(slots, {0.0, 0u});
+  recent_scratch_.assign(slots, 0);
   prior_factors_.Init(config.max_plane_priors);
   floor_members_.Init(config.max_scan_points);
   next_sequence_ = 1;
@@ -149,10 +152,14 @@ bool LocalMapper::Preprocess(const LidarScanView& scan,
 // own covariances (from the union, which is denser than any one keyframe).
 bool LocalMapper::BuildLocalMap(std::uint32_t last) {
   const std::size_t count = graph_.RecentKeyframes(std::span(recent_));
+  return BuildMapFrom(last, std::span<const std::uint32_t>(recent_.data(), count));
+}
+
+// The clouds of `keyframes` (in that order, until local_raw_ is full) in the frame of `last`.
+bool LocalMapper::BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t> keyframes) {
   const Eigen::Isometry3d T_last_map = graph_.keyframe_pose(last).inverse();
   local_raw_.clear();
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::uint32_t k = recent_[i];
+  for (const std::uint32_t k : keyframes) {
     const auto cloud = clouds_.Get(k, sequence_[k]);
     const Eigen::Affine3f T = (T_last_map * graph_.keyframe_pose(k)).cast<float>();
     for (const Eigen::Vector3f& p : cloud) {
@@ -170,6 +177,132 @@ bool LocalMapper::BuildLocalMap(std::uint32_t last) {
     return false;
   return static_cast<bool>(local_map_.Build(local_points_.span(), local_covariances_.span(),
                                             config_.local_map_resolution_m));
+}
+
+Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
+                                                 const Eigen::Isometry3d& T_new_start,
+                                                 const Eigen::Isometry3d& T_new_end,
+                                                 const RelocaliseSearch& search) {
+  if (!have_keyframe_) return Error{Errc::kNotFound, "relocalise: the map has no keyframe yet"};
+  if (scan.points_lidar.size() != scan.time_offset_s.size() || !std::isfinite(scan.start_s) ||
+      !std::isfinite(scan.end_s) || scan.end_s < scan.start_s || !(search.step_m > 0) ||
+      !(search.lateral_m >= 0) || !(search.yaw_rad >= 0) || !(search.yaw_step_rad >= 0) ||
+      !search.T_odom_from.matrix().allFinite() || !search.T_odom_to.matrix().allFinite()) {
+    return Error{Errc::kInvalidArgument, "relocalise: bad scan or search"};
+  }
+  if (!Preprocess(scan, T_new_start, T_new_end))
+    return Error{Errc::kDegenerate, "relocalise: too few usable points"};
+  // Seeds relative to the last keyframe (the odometry frame agrees with the map locally).
+  const Eigen::Isometry3d from = last_odometry_.inverse() * search.T_odom_from;
+  const Eigen::Isometry3d to = last_odometry_.inverse() * search.T_odom_to;
+  // The map to search: every keyframe near the segment, nearest first (the robot may have
+  // walked beyond what the last few keyframes saw, into places seen earlier).
+  {
+    const Eigen::Isometry3d& T_map_last = graph_.keyframe_pose(last_keyframe_);
+    const Eigen::Vector2d a = (T_map_last * from).translation().head<2>();
+    const Eigen::Vector2d b = (T_map_last * to).translation().head<2>();
+    const Eigen::Vector2d ab = b - a;
+    std::size_t count = 0;
+    for (std::uint32_t k = 0; k < graph_.keyframe_slots() && count < nearby_.size(); ++k) {
+      if (!graph_.keyframe_active(k)) continue;
+      const Eigen::Vector2d p = graph_.keyframe_pose(k).translation().head<2>();
+      const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+      const double distance_m = (p - (a + t * ab)).norm();
+      if (distance_m <= search.map_radius_m) nearby_[count++] = {distance_m, k};
+    }
+    std::sort(nearby_.begin(), nearby_.begin() + static_cast<std::ptrdiff_t>(count),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (std::size_t i = 0; i < count; ++i) recent_scratch_[i] = nearby_[i].second;
+    if (count == 0 ||
+        !BuildMapFrom(last_keyframe_, std::span<const std::uint32_t>(recent_scratch_.data(), count)))
+      return Error{Errc::kDegenerate, "relocalise: no map near the search"};
+  }
+  const Eigen::Vector3d span = to.translation() - from.translation();
+  const double yaw_from = std::atan2(from.linear()(1, 0), from.linear()(0, 0));
+  double yaw_span = std::atan2(to.linear()(1, 0), to.linear()(0, 0)) - yaw_from;
+  yaw_span = std::atan2(std::sin(yaw_span), std::cos(yaw_span));
+  const int steps = static_cast<int>(std::ceil(span.head<2>().norm() / search.step_m));
+  const int sides = static_cast<int>(std::floor(search.lateral_m / search.step_m + 1e-9));
+  const int turns = search.yaw_step_rad > 0
+                        ? static_cast<int>(std::floor(search.yaw_rad / search.yaw_step_rad + 1e-9))
+                        : 0;
+  // 1. Every seed scored cheaply: how close a sample of the scan falls to the local map's voxel
+  //    means. Only the best few are worth a registration (each costs a keyframe's scan match).
+  struct Ranked {
+    Eigen::Isometry3d seed;
+    double score;
+  };
+  std::array<Ranked, 8> ranked;
+  std::size_t ranked_count = 0;
+  const std::size_t keep = std::min<std::size_t>(ranked.size(), std::max<std::size_t>(1, search.registrations));
+  const std::size_t stride = std::max<std::size_t>(1, down_.size() / 400);
+  const double inv_two_sigma2 = 1.0 / (2.0 * 0.15 * 0.15);
+  Relocalisation best;
+  for (int i = -1; i <= steps + 1; ++i) {
+    const double f = steps == 0 ? 0.0 : static_cast<double>(i) / steps;  // beyond [0, 1] by a step
+    Eigen::Isometry3d on_segment = Eigen::Isometry3d::Identity();
+    on_segment.linear() = RotZ(yaw_from + f * yaw_span);
+    on_segment.translation() = from.translation() + f * span;
+    if (steps == 0) on_segment.translation().x() += i * search.step_m;  // no span: along x
+    for (int side = -sides; side <= sides; ++side) {
+      for (int turn = -turns; turn <= turns; ++turn) {
+        if (best.candidates >= search.max_candidates) break;
+        ++best.candidates;
+        Ranked r;
+        r.seed = on_segment;
+        r.seed.translation() += on_segment.linear() * Eigen::Vector3d(0, side * search.step_m, 0);
+        r.seed.linear() = r.seed.linear() * RotZ(turn * search.yaw_step_rad);
+        r.score = 0;
+        for (std::size_t k = 0; k < down_.size(); k += stride) {
+          const Eigen::Vector3d q = r.seed * down_[k].cast<double>();
+          if (const GaussianVoxel* v = local_map_.Lookup(q))
+            r.score += std::exp(-(q - v->mean).squaredNorm() * inv_two_sigma2);
+        }
+        // Keep the `keep` best, sorted, and apart: a seed next to a better one would only
+        // converge to the same answer (insertion into a handful).
+        bool dominated = false;
+        for (std::size_t j = 0; j < ranked_count && !dominated; ++j) {
+          const Eigen::Isometry3d d = ranked[j].seed.inverse() * r.seed;
+          if (d.translation().head<2>().norm() > 2 * search.step_m + 1e-6 ||
+              Eigen::AngleAxisd(d.linear()).angle() > 2 * search.yaw_step_rad + 1e-6)
+            continue;
+          if (ranked[j].score >= r.score) {
+            dominated = true;
+          } else {  // r replaces its weaker neighbour
+            for (std::size_t m = j + 1; m < ranked_count; ++m) ranked[m - 1] = ranked[m];
+            --ranked_count;
+            --j;
+          }
+        }
+        if (dominated) continue;
+        std::size_t at = ranked_count < keep ? ranked_count++ : keep;
+        while (at > 0 && ranked[at - 1].score < r.score) {
+          if (at < keep) ranked[at] = ranked[at - 1];
+          --at;
+        }
+        if (at < keep) ranked[at] = r;
+      }
+    }
+  }
+  // 2. Registration from the best seeds; the lowest fitness that passes the thresholds wins.
+  bool found = false;
+  double best_fitness = config_.scan_match_max_fitness_m2;
+  const double min_overlap = config_.scan_match_min_overlap * static_cast<double>(down_.size());
+  for (std::size_t k = 0; k < ranked_count; ++k) {
+    auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_, local_points_.span(),
+                               local_tree_, ranked[k].seed, config_.scan_matching);
+    ++best.registrations;
+    if (!result || !result->converged || !(result->fitness < best_fitness) ||
+        static_cast<double>(result->correspondences) < min_overlap) {
+      continue;
+    }
+    best_fitness = result->fitness;
+    best.fitness_m2 = result->fitness;
+    best.T_odom_base = last_odometry_ * result->T_target_source;
+    found = true;
+  }
+  if (!found) return Error{Errc::kNotConverged, "relocalise: no seed aligned to the local map"};
+  return best;
 }
 
 Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObserver* observer) {

@@ -125,12 +125,13 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
           replay->stopped.empty() ? "" : "; stopped early: ", replay->stopped.c_str());
       m.resume_scans_after_s = replay->last_scan_end_s;
       m.resume_odometry_after_s = replay->last_odometry_s;
-      // Live odometry restarts its integration at identity: the SLAM thread re-anchors the new
-      // odometry frame on the last journaled pose (as if the robot had not moved while the node
-      // was down; scan matching takes up what it did move, within max_correction_m).
+      // Live odometry restarts its integration at identity, and the robot may have walked on
+      // while the node was down: the SLAM thread relocalises the first scan against the map.
       if (config.odometry_source != config::OdometrySource::kCandump) {
         m.reanchor_odometry = true;
         m.T_old_last = restore.last_odometry;
+        m.old_last_stamp_s = replay->last_odometry_s;
+        m.new_odometry.Init(config.mapper.odometry_capacity, config.mapper.odometry_max_gap_s);
       }
       std::lock_guard<std::mutex> lock(m.status_mutex);
       m.slam_status.keyframes = m.mapper.stats().keyframes;

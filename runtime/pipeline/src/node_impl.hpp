@@ -143,11 +143,21 @@ struct Node::Impl {
   std::atomic<std::uint64_t> journal_errors{0};
   /// Restored from the journal: recorded inputs skip what is already in the map.
   double resume_scans_after_s = -1, resume_odometry_after_s = -1;
-  /// Live inputs after a resume: new odometry is mapped into the journal's odometry frame by
-  /// T_odom_fix = T_old_last * T_new_first^-1, fixed at the first new sample (SLAM thread).
+  /// Live inputs after a resume: the odometry integration began again at identity, and the
+  /// robot may have moved while the node was down. The new odometry is held in `new_odometry`
+  /// until the first scan it covers is relocalised against the map (LocalMapper::Relocalise,
+  /// searched from where the journal stopped, T_old_last at old_last_stamp_s, along the motion
+  /// it had then); from then on it is mapped into the journal's odometry frame by T_odom_fix
+  /// (SLAM thread only).
   bool reanchor_odometry = false;
   Eigen::Isometry3d T_old_last = Eigen::Isometry3d::Identity();
+  double old_last_stamp_s = 0;
+  core::OdometryBuffer new_odometry;
   std::optional<Eigen::Isometry3d> T_odom_fix;
+  enum class Relocalising { kWait, kSkipScan, kDone };
+  Relocalising RelocaliseOn(const ScanSlot& scan);
+  /// Maps the held new odometry into the mapper (and the journal) through T_odom_fix.
+  void ReleaseNewOdometry();
   void Journal(auto&& write) {
     if (!journal) return;
     std::lock_guard<std::mutex> lock(journal_mutex);

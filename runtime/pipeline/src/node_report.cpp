@@ -113,6 +113,14 @@ void Node::Impl::PrintReport() {
               "%.2f, %.2f) m\n",
               p.robot, p.merged ? "merged" : "NOT merged", p.walls, p.rooms, p.consistent,
               p.matches, T.translation().x(), T.translation().y(), T.translation().z());
+      if (p.hypotheses > 1) {
+        Appendf(text,
+                "    %zu competing hypotheses%s: %zu matches with walls agreeing along %.1f m, "
+                "the best rival %zu along %.1f m\n",
+                p.hypotheses, p.undecided ? ", none clearly better (waiting)" : "",
+                p.hypothesis_matches[0], p.agreement_m[0], p.hypothesis_matches[1],
+                p.agreement_m[1]);
+      }
       Appendf(text,
               "    received: graph %s, descriptors %s, requests %s, clouds %s; malformed %" PRIu64
               ", graph gaps %" PRIu64 "\n",

@@ -5,6 +5,7 @@
 // publishes again when a peer asks for a resync or new priors arrive.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "msgraphs/platform/clock.hpp"
@@ -84,6 +85,67 @@ void Node::Impl::Exchange() {
   slam_status.wire_samples = wire_ms.count();
 }
 
+Node::Impl::Relocalising Node::Impl::RelocaliseOn(const ScanSlot& scan) {
+  const auto at_start = new_odometry.At(scan.start_s);
+  const auto at_end = new_odometry.At(scan.end_s);
+  if (!at_start || !at_end) {
+    const bool later = (!at_end && at_end.error().code == Errc::kWouldBlock);
+    return later && (at_start || at_start.error().code != Errc::kNotFound)
+               ? Relocalising::kWait
+               : Relocalising::kSkipScan;
+  }
+  // Where to look: from where the journal stopped, along the motion the robot had then (its
+  // last half second), for 1.5 times the time since (the robot may have slowed or stopped).
+  core::RelocaliseSearch search;
+  search.T_odom_from = T_old_last;
+  search.T_odom_to = T_old_last;
+  const double since_s = scan.end_s - old_last_stamp_s;
+  if (auto before = mapper.odometry().At(old_last_stamp_s - 0.5); before && since_s > 0) {
+    const Eigen::Isometry3d step = before->T_odom_base.inverse() * T_old_last;
+    const double k = std::min(1.5 * since_s / 0.5, 60.0);
+    const double yaw = std::atan2(step.linear()(1, 0), step.linear()(0, 0));
+    Eigen::Isometry3d ahead = Eigen::Isometry3d::Identity();
+    ahead.linear() = Eigen::AngleAxisd(k * yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    ahead.translation() << k * step.translation().x(), k * step.translation().y(), 0;
+    search.T_odom_to = T_old_last * ahead;
+  }
+  const SteadyTime t0 = platform::SteadyNow();
+  core::LidarScanView view{scan.points, scan.time_offset_s, scan.start_s, scan.end_s};
+  auto found = mapper.Relocalise(view, at_start->T_odom_base, at_end->T_odom_base, search);
+  const double took_s = (platform::SteadyNow() - t0).seconds();
+  Eigen::Isometry3d T_odom_base_now;
+  if (found) {
+    T_odom_base_now = found->T_odom_base;
+    const Eigen::Isometry3d moved = T_old_last.inverse() * T_odom_base_now;
+    std::printf(
+        "relocalised after the restart: the robot moved %.2f m and turned %.1f deg while the node "
+        "was down (%.1f s); fitness %.4f m2, %zu seeds scored, %zu registered, %.2f s\n",
+        moved.translation().head<2>().norm(),
+        Eigen::AngleAxisd(moved.linear()).angle() * 180.0 / 3.14159265358979, since_s,
+        found->fitness_m2, found->candidates, found->registrations, took_s);
+  } else {
+    // Nothing aligned (an empty map, a scan of a place not mapped yet): as if the robot had
+    // stood still; scan matching then takes up what it moved within max_correction_m.
+    T_odom_base_now = T_old_last * new_odometry.pose(0).inverse() * at_end->T_odom_base;
+    std::printf("WARNING: relocalisation after the restart failed (%s); resuming from the last "
+                "journaled pose\n",
+                found.error().detail);
+  }
+  std::fflush(stdout);
+  T_odom_fix = T_odom_base_now * at_end->T_odom_base.inverse();
+  return Relocalising::kDone;
+}
+
+void Node::Impl::ReleaseNewOdometry() {
+  for (std::size_t i = 0; i < new_odometry.size(); ++i) {
+    const double stamp_s = new_odometry.stamp(i);
+    const Eigen::Isometry3d T_odom_base = *T_odom_fix * new_odometry.pose(i);
+    static_cast<void>(mapper.AddOdometry(stamp_s, T_odom_base));
+    Journal([&](JournalWriter& j) { return static_cast<bool>(j.Odometry(stamp_s, T_odom_base)); });
+  }
+  new_odometry.Clear();
+}
+
 void Node::Impl::SlamLoop() {
   static_cast<void>(platform::SetCurrentThreadName("msg-slam"));
   double next_exchange_s = -1;
@@ -96,7 +158,12 @@ void Node::Impl::SlamLoop() {
       if (o->stamp_s > horizon_s) break;
       Eigen::Isometry3d T_odom_base = o->T_odom_base;
       if (reanchor_odometry) {
-        if (!T_odom_fix) T_odom_fix = T_old_last * o->T_odom_base.inverse();
+        if (!T_odom_fix) {
+          // Held until a scan is relocalised (RelocaliseOn); refused samples are counted there.
+          static_cast<void>(new_odometry.Add(o->stamp_s, o->T_odom_base));
+          odometry.Pop();
+          continue;
+        }
         T_odom_base = *T_odom_fix * o->T_odom_base;
       }
       static_cast<void>(mapper.AddOdometry(o->stamp_s, T_odom_base));
@@ -116,6 +183,19 @@ void Node::Impl::SlamLoop() {
     }
     const double needed_s = scan->end_s + kOdometryMargin_s;
     drain_odometry(lockstep() ? needed_s + 0.05 : inf);
+    if (reanchor_odometry && !T_odom_fix) {
+      const Relocalising r = RelocaliseOn(*scan);
+      if (r == Relocalising::kWait &&
+          platform::SteadyNow() - scan->last_packet < kOdometryPatience) {
+        static_cast<void>(odometry.Front(kWait));
+        continue;
+      }
+      if (r != Relocalising::kDone) {  // older than the new odometry, or it never came
+        scans.Pop();
+        continue;
+      }
+      ReleaseNewOdometry();
+    }
     if (mapper.odometry().newest_stamp() < needed_s && !odometry_ended()) {
       // A scan older than every odometry sample kept will never be covered: no use waiting.
       const auto start_pose = mapper.odometry().At(scan->start_s);

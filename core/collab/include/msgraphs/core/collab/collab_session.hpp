@@ -26,6 +26,7 @@
 
 #include "msgraphs/base/expected.hpp"
 #include "msgraphs/core/collab/distiller.hpp"
+#include "msgraphs/core/collab/hypothesis_check.hpp"
 #include "msgraphs/core/collab/room_descriptor.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
@@ -98,6 +99,7 @@ struct CollabSessionConfig {
   DistillerConfig distiller;
   RoomDescriptorConfig descriptor;
   RoomMatchConfig matcher;
+  HypothesisCheckConfig hypotheses;  ///< competing consistent sets, told apart by the walls
   CollaborativeGraphConfig graph;
   Status Validate() const;
 };
@@ -108,6 +110,14 @@ struct CollabPeerStats {
   std::uint32_t graph_version = 0;
   std::size_t walls = 0, rooms = 0, descriptors = 0;
   std::size_t matches = 0, consistent = 0;
+  /// Competing consistent sets of matches (hypotheses of the map-to-map transform), and whether
+  /// none of them is clearly better (the robot is then not merged: it waits for more).
+  std::size_t hypotheses = 0;
+  bool undecided = false;
+  /// Metres of wall that agree under the chosen set (the first when undecided) and under its
+  /// best rival (0 without one): WallAgreement_m.
+  double agreement_m[2] = {};
+  std::size_t hypothesis_matches[2] = {};  ///< the sizes of those two sets
   std::uint64_t bytes_received[kCollabMessageTypes] = {};
   std::uint64_t messages_received[kCollabMessageTypes] = {};
   std::uint64_t malformed = 0;   ///< rejected by a decoder, any type
@@ -125,6 +135,7 @@ struct CollabSessionStats {
   std::uint64_t checked_anchored = 0, rejected_anchored = 0;
   std::uint64_t rejected_consistency = 0;  ///< currently outside the consistent sets
   std::uint64_t accepted = 0;              ///< currently inside them
+  std::uint64_t undecided = 0;  ///< peers with competing hypotheses and none clearly better
   std::uint64_t solves = 0, solve_failures = 0;
   /// Distillations with marginal wall covariances, and those that fell back to conditional ones.
   std::uint64_t marginal_updates = 0, marginal_failures = 0;

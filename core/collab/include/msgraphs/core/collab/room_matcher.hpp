@@ -10,11 +10,12 @@
 //   transform between the two robots' map frames.
 // - Consistency: every accepted match between the same two robots proposes the same map-to-map
 //   transform if they are right. Pairs that agree (translation and yaw) form a graph; its
-//   maximum clique is kept and everything else is rejected. Identical rooms of a symmetric
-//   building each align perfectly but to different transforms, so they do not agree with the
-//   true matches. A clique smaller than `min_consistent` keeps nothing (one match alone cannot be
-//   checked), and so does a tie: when another set of matches, disjoint from the largest, is as
-//   large, the building's symmetry has not been broken yet.
+//   maximum cliques, taken one after the other from what is left, are the competing hypotheses
+//   (MatchHypotheses). Identical rooms of a symmetric building each align perfectly but to
+//   different transforms, so they gather in a rival hypothesis instead of joining the truth.
+//   ConsistentMatches keeps the largest unless it is smaller than `min_consistent` (one match
+//   alone cannot be checked) or a rival is as large; the collaborative session decides among
+//   hypotheses by the rest of the two maps instead (hypothesis_check.hpp).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -85,11 +86,22 @@ Eigen::Isometry3d MatchFromRoomFrames(const Eigen::Isometry3d& T_mapa_rooma,
                                       const Eigen::Isometry3d& T_mapb_roomb,
                                       double yaw_rad);
 
-/// Indices of the largest set of mutually consistent matches (all between the same two robots);
-/// empty when it is smaller than config.min_consistent or when a disjoint set is as large (two
-/// hypotheses, no answer yet). At most 64 matches are considered.
+/// The competing hypotheses about the map-to-map transform: disjoint sets of mutually
+/// consistent matches (all between the same two robots), as bit sets over `matches`, largest
+/// first (the maximum clique, then the maximum clique of the rest, ...). Stops when `out` is full
+/// or the next set is smaller than `min_matches` (at least 1). At most 64 matches are considered.
+std::size_t MatchHypotheses(std::span<const RoomMatch> matches,
+                            const RoomMatchConfig& config,
+                            std::size_t min_matches,
+                            std::span<std::uint64_t> out);
+
+/// Indices of the largest set of mutually consistent matches; empty when it is smaller than
+/// config.min_consistent or when a disjoint set is as large (two hypotheses, no answer yet).
 std::size_t ConsistentMatches(std::span<const RoomMatch> matches,
                               const RoomMatchConfig& config,
                               std::span<std::uint32_t> out);
+
+/// The indices a hypothesis bit set holds, ascending, into `out`; returns how many.
+std::size_t HypothesisMembers(std::uint64_t hypothesis, std::span<std::uint32_t> out);
 
 }  // namespace msgraphs::core

@@ -22,6 +22,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "msgraphs/base/bounded_vector.hpp"
@@ -134,6 +135,32 @@ struct LocalMapperStats {
   std::size_t local_map_points_peak = 0;
 };
 
+/// Where to look for the robot after its odometry integration restarted (Relocalise): on the
+/// segment between two poses of this mapper's odometry frame (where it stopped, where it would
+/// be had it kept its speed), one step beyond each end, up to `lateral_m` to either side and
+/// `yaw_rad` either way of the heading interpolated along it.
+struct RelocaliseSearch {
+  Eigen::Isometry3d T_odom_from = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_odom_to = Eigen::Isometry3d::Identity();
+  double step_m = 0.25;  ///< seed spacing, along and across (VGICP's basin is wider)
+  double lateral_m = 0.5;
+  /// Every heading by default, in 10 degree steps: a legged robot turns on the spot, and in
+  /// the HIL run it turned 250 degrees at a dead end while the node was down.
+  double yaw_rad = 3.1416, yaw_step_rad = 0.1745;
+  std::size_t max_candidates = 20000;  ///< seeds scored; the segment is cut short beyond
+  /// Keyframes within this distance of the segment make the map searched, nearest first, as
+  /// many as the local map holds (the robot may have walked beyond the last few keyframes).
+  double map_radius_m = 10.0;
+  std::size_t registrations = 6;      ///< the best-scored seeds registered (at most 8)
+};
+
+struct Relocalisation {
+  Eigen::Isometry3d T_odom_base = Eigen::Isometry3d::Identity();  ///< at the scan's end
+  double fitness_m2 = 0;
+  std::size_t candidates = 0;     ///< seeds scored
+  std::size_t registrations = 0;  ///< of them registered
+};
+
 class LocalMapper {
  public:
   Status Init(const LocalMapperConfig& config);
@@ -143,6 +170,20 @@ class LocalMapper {
 
   /// kNoOdometry: the scan's end is not inside the buffered odometry (feed odometry first).
   Expected<ScanOutcome> AddScan(const LidarScanView& scan, StageObserver* observer = nullptr);
+
+  /// Where `scan` was taken, in this mapper's odometry frame, when the odometry cannot say: a
+  /// restarted node whose odometry integration began again at identity while the robot moved.
+  /// `T_new_start`/`T_new_end` are the new odometry at the scan's start and end (only their
+  /// relative motion is used, to deskew). Every seed of `search` is scored by how close a
+  /// sample of the scan falls to the local map's voxels (the last keyframes); the best few are
+  /// registered by VGICP, and the lowest fitness within the scan-matching thresholds (fitness,
+  /// overlap) wins. Changes nothing in the map: the caller maps its new odometry frame
+  /// with the answer (T_odom_base * T_new_end^-1) and goes on with AddOdometry and AddScan.
+  /// kNotFound without a keyframe; kNotConverged when no seed passes.
+  Expected<Relocalisation> Relocalise(const LidarScanView& scan,
+                                      const Eigen::Isometry3d& T_new_start,
+                                      const Eigen::Isometry3d& T_new_end,
+                                      const RelocaliseSearch& search);
 
   /// A full solve now (for example at the end of a mission).
   Status Finish();
@@ -182,6 +223,7 @@ class LocalMapper {
                   const Eigen::Isometry3d& T_odom_start,
                   const Eigen::Isometry3d& T_odom_end);
   bool BuildLocalMap(std::uint32_t last);
+  bool BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t> keyframes);
   Matrix6d OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const;
   void ExtractPlanes();
 
@@ -207,6 +249,8 @@ class LocalMapper {
   std::vector<std::uint64_t> sequence_;               // per keyframe slot
   std::vector<Eigen::Isometry3d> keyframe_odometry_;  // per keyframe slot
   std::vector<std::uint32_t> recent_;
+  std::vector<std::pair<double, std::uint32_t>> nearby_;  // Relocalise: (distance, keyframe)
+  std::vector<std::uint32_t> recent_scratch_;
   BoundedVector<std::uint32_t> prior_factors_;  // factor ids of the current plane priors
   std::uint64_t next_sequence_ = 1;
   bool have_keyframe_ = false;

@@ -38,6 +38,11 @@ class OdometryBuffer {
   Expected<OdometryLookup> At(double stamp_s) const;
 
   std::size_t size() const { return size_; }
+  /// The i-th pose kept, 0 the oldest (i < size()).
+  double stamp(std::size_t i) const { return stamps_[Index(i)]; }
+  const Eigen::Isometry3d& pose(std::size_t i) const { return poses_[Index(i)]; }
+  /// Forgets every pose (statistics stay).
+  void Clear() { head_ = size_ = 0; }
   std::size_t capacity() const { return stamps_.size(); }
   double newest_stamp() const;
   const OdometryBufferStats& stats() const { return stats_; }
