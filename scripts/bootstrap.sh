@@ -34,6 +34,7 @@ host_packages=(
   libpcl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   iproute2 nftables
+  python3 librsvg2-bin  # tools/eval: results tables; the demo picture as PNG
 )
 cross_packages=(g++-aarch64-linux-gnu qemu-user-static mmdebstrap file)  # file: CI shows the binaries' architecture
 fuzz_packages=(clang libclang-rt-14-dev)

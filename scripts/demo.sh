@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The README's main command: installs what is missing, builds (host release) and runs the most
-# complete real pipeline that exists so far: a simulated three-robot fleet, one msgraphs_node
-# process per robot, each mapping its own recording (VLP-16 pcap + CAN candump) and exchanging
-# its distilled graph, room descriptors and room clouds with the others over real Fast DDS on
-# 127.0.0.1, until every robot has placed every other one in its map.
+# The README's main command: installs what is missing, builds (host release), checks what this
+# machine grants a node, then runs the demo: a simulated three-robot mission in the office
+# world (generated on first use, kept in out/missions/), three msgraphs_node processes over real
+# Fast DDS on 127.0.0.1, each fed its robot's Velodyne packets and CAN odometry over UDP by
+# msgraphs_replay at the recorded pace (3 minutes). It ends with a report per robot and writes
+# everything into out/demo/ (docs/demo.md says what each file is).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 scripts/bootstrap.sh
@@ -15,9 +16,9 @@ echo
 echo "=== 1. node self-check: platform capabilities and a Fast DDS exchange on loopback"
 "$node" --self-check --domain 90
 echo
-echo "=== 2. three robots, three msgraphs_node processes, real Fast DDS on 127.0.0.1"
-scripts/run_fleet.sh --world office --robots 3 --duration-s 180 --out build/demo
+echo "=== 2. three robots: three msgraphs_node processes fed over UDP, real Fast DDS on 127.0.0.1"
+scripts/run_fleet.sh --world office --robots 3 --duration-s 180 --out out/demo --inputs udp
 echo
-echo "Each robot's keyframes (TUM) and where it placed the others (origins.csv): build/demo/out/robotN/."
-echo "docs/runtime.md explains the node; the full demo (live UDP replay, merged map and picture)"
-echo "and the evaluation suite are still open: see 'issues'."
+echo "Output folder out/demo/: robotN.tum (every robot's keyframes in robot 1's frame, TUM for evo),"
+echo "merged_map.pcd (PCL, CloudCompare), collab_graph.svg (the collaborative S-Graph from above),"
+echo "report.txt; each node's own outputs (map.pcd, collab_graph.g2o, ...) in out/demo/nodes/robotN/."

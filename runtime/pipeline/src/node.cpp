@@ -374,6 +374,7 @@ int Node::Run(const std::atomic<bool>& stop) {
   if (m.led) m.led->SetHealth(drivers::gpio::Health::kOff, platform::SteadyNow());
   m.PrintStatus((platform::SteadyNow() - m.started).seconds());
   m.WriteOutputs();
+  m.WriteExports();
   m.PrintReport();
   return exit_code;
 }

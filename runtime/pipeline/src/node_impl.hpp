@@ -184,6 +184,7 @@ struct Node::Impl {
   link::Telemetry MakeTelemetry() const;
   void PrintStatus(double since_start_s);
   void WriteOutputs();
+  void WriteExports();  // node_exports.cpp: map.pcd, collab_graph.{csv,g2o}
   void PrintReport();
 };
 

@@ -194,11 +194,46 @@ void Node::Impl::PrintReport() {
           static_cast<double>(usage.ru_stime.tv_sec) +
               static_cast<double>(usage.ru_stime.tv_usec) * 1e-6,
           static_cast<double>(usage.ru_maxrss) / 1024.0);
+  // The same figures for scripts (tools/eval reads them): one "key value" per line.
+  std::string stats;
+  {
+    std::lock_guard<std::mutex> lock(session_mutex);
+    const core::CollabSessionStats& cs = session.stats();
+    std::uint64_t received[4] = {};
+    std::size_t merged = 0;
+    for (std::size_t i = 0; i < session.peers(); ++i) {
+      const core::CollabPeerStats p = session.peer_stats(i);
+      for (int k = 0; k < 4; ++k) received[k] += p.bytes_received[k];
+      if (p.merged) ++merged;
+    }
+    Appendf(stats,
+            "robot %u\nscans %" PRIu64 "\nkeyframes %" PRIu64
+            "\nwalls %u\nrooms %u\npeers %zu\nmerged %zu\n",
+            config.robot.value, s.scans, s.keyframes, s.walls, s.rooms, session.peers(), merged);
+    Appendf(stats,
+            "matches_proposed %" PRIu64 "\nmatches_rejected_fine %" PRIu64
+            "\nmatches_rejected_anchored %" PRIu64 "\nmatches_rejected_consistency %" PRIu64
+            "\nmatches_accepted %" PRIu64 "\n",
+            cs.proposals, cs.rejected_fine, cs.rejected_anchored, cs.rejected_consistency,
+            cs.accepted);
+    const char* kinds[] = {"graph", "descriptors", "requests", "clouds"};
+    for (int k = 0; k < 4; ++k) {
+      Appendf(stats, "sent_%s_bytes %" PRIu64 "\nreceived_%s_bytes %" PRIu64 "\n", kinds[k],
+              cs.bytes_sent[k], kinds[k], received[k]);
+    }
+  }
+  Appendf(stats,
+          "keyframe_p50_ms %.2f\nkeyframe_p99_ms %.2f\nwire_p50_ms %.1f\nwire_p99_ms %.1f\n"
+          "scan_queue_peak %zu\nscans_dropped %" PRIu64 "\npeak_rss_mb %.1f\n",
+          s.keyframe_p50_ms, s.keyframe_p99_ms, s.wire_p50_ms, s.wire_p99_ms, sq.peak, sq.dropped,
+          static_cast<double>(usage.ru_maxrss) / 1024.0);
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
   if (!config.output_dir.empty()) {
     std::ofstream out(std::filesystem::path(config.output_dir) / "report.txt");
     out << text;
+    std::ofstream stats_out(std::filesystem::path(config.output_dir) / "stats.txt");
+    stats_out << stats;
   }
 }
 

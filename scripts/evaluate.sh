@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The evaluation: installs what is missing, builds (host release), then runs every shipped world
+# with 2 and 3 robots and writes docs/results.md (the paper's tables for our worlds, per-stage
+# timing and peak memory, the nodes, the budget check), stamped with the commit. About 40
+# minutes on 2 cores; the work folder (default out/eval) keeps every log and recording, and a
+# second run reuses the recordings.
+#
+#   scripts/evaluate.sh [--work out/eval] [--results docs/results.md]
+#
+# Exit status: 0, or 1 when a run failed or a stage is over its budget (the results are
+# written either way).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+work=out/eval; results=docs/results.md
+while [[ $# -gt 0 ]]; do
+  case $1 in
+    --work) work=$2; shift 2 ;;
+    --results) results=$2; shift 2 ;;
+    *) echo "usage: $0 [--work DIR] [--results FILE]" >&2; exit 2 ;;
+  esac
+done
+started=$(date +%s)
+scripts/bootstrap.sh
+cmake --preset host-release >/dev/null
+cmake --build --preset host-release
+build=build/host-release
+mkdir -p "$work"
+work=$(realpath "$work")
+worlds=(office construction apartment rotated)
+rc=0
+
+echo; echo "=== 1/4 msgraphs_collab: every world, 2 robots in every ablation mode and the keyframe baseline, 3 robots"
+tools/eval/multi_robot_runs.sh "$build" "$work" || rc=1
+
+echo; echo "=== 2/4 msgraphs_slam: per-stage timing and memory, every robot of the 3-robot missions, one at a time"
+mkdir -p "$work/slam"
+for w in "${worlds[@]}"; do
+  for k in 1 2 3; do
+    "$build/tools/msgraphs_slam" --run "$work/sim3/$w" --robot $k > "$work/slam/$w-robot$k.txt" 2>&1 || rc=1
+    grep -m1 "ATE RMSE" "$work/slam/$w-robot$k.txt" | sed "s/^/  $w robot $k: /"
+  done
+done
+
+echo; echo "=== 3/4 scripts/run_fleet.sh: three msgraphs_node processes per world over real Fast DDS"
+mkdir -p "$work/missions" "$work/fleet"
+for w in "${worlds[@]}"; do
+  # The same recordings as the collab runs (300 s, seed 1): no second simulation.
+  ln -sfn "$work/sim3/$w" "$work/missions/$w-3-300"
+  MSGRAPHS_MISSIONS="$work/missions" scripts/run_fleet.sh --world "$w" --robots 3 --duration-s 300 \
+    --out "$work/fleet/$w" --inputs lockstep > "$work/fleet/$w.log" 2>&1 || rc=1
+  grep "robot 1's view" "$work/fleet/$w.log" | sed "s/^/  $w: /" || true
+done
+
+echo; echo "=== 4/4 the budget check (tools/eval/budgets.txt)"
+budget_rc=0
+tools/eval/budget_check.py --build "$build" --slam-log "$work/slam/office-robot1.txt" \
+  --fleet "$work/fleet/office" --markdown "$work/budget.md" || budget_rc=$?
+[[ $budget_rc -eq 0 ]] || rc=1
+
+commit=$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . ':!docs/results.md' || echo "+uncommitted changes")
+minutes=$(( ($(date +%s) - started) / 60 ))
+tools/eval/results.py "$work" --commit "$commit" --budget-status $budget_rc --minutes $minutes > "$results"
+echo
+echo "wrote $results (commit $commit, $minutes min); logs in $work"
+sed -n '/## 1\./,/## 2\./p' "$results" | head -8
+exit $rc
