@@ -8,7 +8,8 @@ figure). Exit 1 when a measured stage exceeds its budget, 2 on a usage or measur
 
 Sources: "bench:<binary>:<benchmark>" runs build/bench/msgraphs_<binary>_bench (Google
 Benchmark, JSON); "slam:<stage>" runs msgraphs_slam on RUN's robot (per-stage percentiles of a
-keyframe and the peak RSS), or reads --slam-log; "fleet:<key>" reads every node's stats.txt in
+keyframe and the peak RSS), or reads --slam-log (repeatable: the worst of each statistic
+over the runs); "fleet:<key>" reads every node's stats.txt in
 FLEET_OUT/nodes/robotN (the largest). Rows whose source is absent are reported as not measured
 (a benchmark that needs ../shared/data without it, no --fleet) and do not fail the check.
 """
@@ -92,7 +93,9 @@ def main():
     ap.add_argument("--build", required=True)
     ap.add_argument("--run", help="a simulator run (msgraphs_sim --out) for the per-keyframe stages")
     ap.add_argument("--robot", type=int, default=1)
-    ap.add_argument("--slam-log", help="msgraphs_slam output to read instead of running it")
+    ap.add_argument("--slam-log", action="append",
+                    help="msgraphs_slam output to read instead of running it; repeated, the worst of "
+                         "each statistic over all of them is checked")
     ap.add_argument("--fleet", help="scripts/run_fleet.sh output folder (node memory)")
     ap.add_argument("--budgets", default=os.path.join(os.path.dirname(__file__), "budgets.txt"))
     ap.add_argument("--data", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -119,7 +122,13 @@ def main():
             bench_results.update(run_benchmarks(args.build, binary, names, env))
         slam = None
         if args.slam_log:
-            slam = parse_slam(open(args.slam_log).read())
+            # The worst of each stage's statistic over every run given.
+            slam = {}
+            for path in args.slam_log:
+                for stage, stats in parse_slam(open(path).read()).items():
+                    worst = slam.setdefault(stage, {})
+                    for k, v in stats.items():
+                        worst[k] = max(worst.get(k, v), v)
         elif args.run and any(r["source"].startswith("slam:") for r in rows):
             exe = os.path.join(args.build, "tools", "msgraphs_slam")
             out = subprocess.run([exe, "--run", args.run, "--robot", str(args.robot)],

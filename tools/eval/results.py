@@ -113,12 +113,12 @@ def cm(m):
     return f"{m * 100:.1f}"
 
 
-def avg_std(values):
+def avg_std(values, digits=2):
     if not values:
         return "-"
     if len(values) == 1:
-        return f"{values[0]:.2f}"
-    return f"{statistics.mean(values):.2f} ± {statistics.stdev(values):.2f}"
+        return f"{values[0]:.{digits}f}"
+    return f"{statistics.mean(values):.{digits}f} ± {statistics.stdev(values):.{digits}f}"
 
 
 def main():
@@ -182,7 +182,7 @@ def main():
     for n in (2, 3):
         vals = [collab[(w, n, "rooms-walls-fine")] for w, _ in WORLDS]
         p(f"| {n} | " + " | ".join(f"{v['mb']:.3f}" if v else "-" for v in vals) + " | "
-          + avg_std([v["mb"] for v in vals if v]) + " |")
+          + avg_std([v["mb"] for v in vals if v], 3) + " |")
     p("")
     p("| world | robots | " + " | ".join(TYPES[:4]) + " |")
     p("|---|---|" + "---|" * 4)
@@ -257,7 +257,8 @@ def main():
     if budget:
         status = {0: "every measured stage within its budget", 1: "**a stage is over its budget**"}.get(
             a.budget_status, "not completed")
-        p(f"`tools/eval/budget_check.py` (office, robot 1; fleet nodes of section 6): {status}.\n")
+        p(f"`tools/eval/budget_check.py`: the worst of each stage over every robot of section 5, the largest "
+          f"office node of section 6 against the host figures of [budgets.md](budgets.md): {status}.\n")
         p(budget)
     else:
         p("Not run.\n")
