@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-60}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session node_config)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session node_config pcd_reader)
 DATA=${MSGRAPHS_DATA_DIR:-$(pwd)/../shared/data}
 
 cmake --preset fuzz >/dev/null
@@ -18,9 +18,15 @@ cmake --build --preset fuzz >/dev/null
 
 WORK=$(mktemp -d); trap 'rm -rf "$WORK"' EXIT
 mkdir -p build/fuzz/artifacts
-mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session,node_config}
+mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session,node_config,pcd_reader}
 # The shipped example configuration seeds the config fuzzer.
 cp runtime/node/example.conf "$WORK/node_config/"
+# PCD seeds: a small binary map as the node writes it, an ascii file with an extra field.
+printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA binary\n' \
+  > "$WORK/pcd_reader/binary.pcd"
+head -c 24 /dev/zero >> "$WORK/pcd_reader/binary.pcd"
+printf 'VERSION .7\nFIELDS x y z intensity\nSIZE 4 4 4 2\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 7\nnan 0 0 1\n' \
+  > "$WORK/pcd_reader/ascii.pcd"
 if [ -d "$DATA/pcap" ]; then
   # Single packets of the einride recording, and the small captures whole.
   python3 - "$DATA/pcap/einride_vlp16_recording_1000pkts.bin" "$WORK/velodyne_decoder" <<'PY'

@@ -109,6 +109,17 @@ TEST(PcdFile, RefusesMalformedFilesWithAReason) {
       {"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS -5\nDATA ascii\n", Errc::kMalformed},
       {"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 99999999\nPOINTS 1\nDATA ascii\n",
        Errc::kMalformed},
+      // A hostile point count: refused (binary) or stopped at the data's end (ascii), never
+      // a reservation of gigabytes.
+      {"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 2000000000\nDATA binary\n" +
+           std::string(12, '\0'),
+       Errc::kMalformed},
+      {"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 2000000000\nDATA ascii\n1 2 3\n",
+       Errc::kMalformed},
+      // Found by the fuzzer: WIDTH x HEIGHT overflowing when there is no POINTS line.
+      {"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 99999999999999999999999\nHEIGHT 2\n"
+       "DATA binary\n",
+       Errc::kMalformed},
   };
   for (const auto& [text, code] : cases) {
     WriteText(path, text);
@@ -117,6 +128,7 @@ TEST(PcdFile, RefusesMalformedFilesWithAReason) {
     EXPECT_EQ(read.error().code, code) << read.error().detail << " for: " << text.substr(0, 60);
   }
   EXPECT_FALSE(ReadPcd(TempPath("does_not_exist.pcd")));
+  EXPECT_EQ(ReadPcd(TempPath("does_not_exist.pcd")).error().code, Errc::kIo);
   std::remove(path.c_str());
 }
 

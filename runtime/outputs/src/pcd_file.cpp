@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/runtime/outputs/pcd_file.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 namespace msgraphs::runtime {
@@ -46,8 +48,15 @@ Status WritePcd(const std::string& path, std::span<const Eigen::Vector3f> points
 }
 
 Expected<std::vector<Eigen::Vector3f>> ReadPcd(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{Errc::kIo, "pcd: cannot open the file", errno};
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Error{Errc::kIo, "pcd: cannot open the file", errno};
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (file.bad()) return Error{Errc::kIo, "pcd: read failed", errno};
+  return ParsePcd(bytes);
+}
+
+Expected<std::vector<Eigen::Vector3f>> ParsePcd(std::string_view bytes) {
+  std::istringstream in{std::string(bytes)};
   std::vector<std::string> fields;
   std::vector<int> sizes, counts;
   std::vector<char> types;
@@ -82,12 +91,18 @@ Expected<std::vector<Eigen::Vector3f>> ReadPcd(const std::string& path) {
   if (fields.empty() || sizes.size() != fields.size() || types.size() != fields.size() ||
       counts.size() != fields.size())
     return Error{Errc::kMalformed, "pcd: FIELDS, SIZE, TYPE and COUNT disagree"};
-  if (points < 0) points = width * height;
-  if (points < 0 || points > (1LL << 31)) return Error{Errc::kMalformed, "pcd: bad point count"};
+  constexpr long long kMaxPoints = 1LL << 31;
+  if (points < 0) {  // no POINTS line: WIDTH x HEIGHT, each checked before the product
+    if (width < 0 || height < 0 || width > kMaxPoints || height > kMaxPoints)
+      return Error{Errc::kMalformed, "pcd: bad WIDTH or HEIGHT"};
+    points = width * height;
+  }
+  if (points < 0 || points > kMaxPoints) return Error{Errc::kMalformed, "pcd: bad point count"};
   // Byte offset (binary) and column (ascii) of x, y and z.
-  int offset[3] = {-1, -1, -1};
+  long long offset[3] = {-1, -1, -1};
   std::size_t column[3] = {0, 0, 0};
-  int stride = 0, columns = 0;
+  long long stride = 0, columns = 0;
+  if (fields.size() > 1024) return Error{Errc::kMalformed, "pcd: too many fields"};
   for (std::size_t i = 0; i < fields.size(); ++i) {
     if (sizes[i] <= 0 || counts[i] <= 0 || sizes[i] > 8 || counts[i] > 4096)
       return Error{Errc::kMalformed, "pcd: bad field size or count"};
@@ -101,10 +116,18 @@ Expected<std::vector<Eigen::Vector3f>> ReadPcd(const std::string& path) {
     stride += sizes[i] * counts[i];
     columns += counts[i];
   }
+  if (columns > 65536) return Error{Errc::kMalformed, "pcd: too many values a point"};
   if (offset[0] < 0 || offset[1] < 0 || offset[2] < 0)
     return Error{Errc::kMalformed, "pcd: no x y z fields"};
+  // What is left after the header bounds how many points can follow: a hostile POINTS line
+  // must not make us reserve gigabytes.
+  const std::streamoff header_end = in.tellg();
+  const auto remaining =
+      static_cast<long long>(bytes.size()) - (header_end < 0 ? 0 : static_cast<long long>(header_end));
+  if (data == "binary" && points * stride > remaining)
+    return Error{Errc::kMalformed, "pcd: file truncated"};
   std::vector<Eigen::Vector3f> out;
-  out.reserve(static_cast<std::size_t>(points));
+  out.reserve(static_cast<std::size_t>(std::min(points, remaining / 2 + 1)));
   auto keep = [&](float x, float y, float z) {
     if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) out.emplace_back(x, y, z);
   };

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "msgraphs/base/expected.hpp"
@@ -21,6 +22,8 @@ Status WritePcd(const std::string& path, std::span<const Eigen::Vector3f> points
 
 /// Reads the x y z fields of a PCD file; points with a non-finite coordinate are skipped.
 Expected<std::vector<Eigen::Vector3f>> ReadPcd(const std::string& path);
+/// The same from the file's bytes (what ReadPcd does after reading the file; fuzzed).
+Expected<std::vector<Eigen::Vector3f>> ParsePcd(std::string_view bytes);
 
 /// A voxel's key for thinning a map to one point per voxel: 21 bits per axis, unique within
 /// +-52 km of the origin at 5 cm.
