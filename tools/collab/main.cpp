@@ -59,12 +59,13 @@ enum MessageType {
   kDescriptor,
   kCloudRequest,
   kCloud,
+  kFreeSpace,
   kKeyframeDescriptor,
   kKeyframeCloud,
   kMessageTypes
 };
 const char* kTypeNames[kMessageTypes] = {"distilled graph",      "room descriptors",
-                                         "room cloud requests",  "room clouds",
+                                         "room cloud requests",  "room clouds", "free space",
                                          "keyframe descriptors", "keyframe clouds"};
 constexpr std::size_t kKeyframePoseBytes = 28;  // a keyframe's pose beside its descriptor (7 x f32)
 constexpr float kKeyframeScThreshold = 0.25f;   // keyframe candidates (tighter: many more of them)
@@ -209,6 +210,7 @@ struct Mission {
     radio.queue.clear();
   }
 
+  double now_s = 0;  // mission time of the exchange
   void Exchange() {
     if (keyframes) {
       for (auto& r : robots) ExchangeKeyframes(*r);
@@ -224,7 +226,7 @@ struct Mission {
     for (int round = 0; round < 2; ++round) {
       for (auto& r : robots) {
         radio.sender = r->index;
-        r->session.Match(radio);
+        r->session.Match(radio, now_s);
       }
       Deliver();
     }
@@ -363,7 +365,10 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "collab: --hypotheses takes walls or count\n");
         return 2;
       }
-      session_config.hypotheses.use_walls = h == "walls";
+      if (h == "count") {
+        std::fprintf(stderr, "collab: --hypotheses count is gone: the merge rule decides (docs/multi-robot.md)\n");
+        return 2;
+      }
     } else if (a == "--delay-s" && i + 1 < argc) {
       // ROBOT=SECONDS: that robot starts later in mission time (a late joiner when longer than
       // the others' missions: it arrives with its whole map).
@@ -478,6 +483,7 @@ int main(int argc, char** argv) {
     if (next == nullptr) break;
     const double t = Now(*next);
     if (t >= next_exchange) {
+      mission.now_s = t;
       mission.Exchange();
       timeline.push_back({t, {}});
       for (int k = 0; k < kMessageTypes; ++k)
@@ -627,12 +633,12 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < r->session.peers(); ++i) {
       const core::CollabPeerStats p = r->session.peer_stats(i);
       const int wrong_here = wrong_in_view[{r->id(), p.robot}];
-      if (p.hypotheses < 2 && p.merged && wrong_here == 0) continue;
-      std::printf("  view of robot %d: robot %u %s, %zu hypotheses%s (%zu matches, walls agree "
-                  "%.1f m; best rival %zu matches, %.1f m); %d accepted matches wrong\n",
-                  r->index + 1, p.robot, p.merged ? "merged" : "NOT merged", p.hypotheses,
-                  p.undecided ? ", undecided" : "", p.hypothesis_matches[0], p.agreement_m[0],
-                  p.hypothesis_matches[1], p.agreement_m[1], wrong_here);
+      std::printf("  view of robot %d: robot %u %s (%s), %zu hypotheses (%zu refuted); leader: walls "
+                  "agree %.1f m, %.1f m in the weakest direction, %.1f m conflict; rival %.1f m%s; %d "
+                  "accepted matches wrong\n",
+                  r->index + 1, p.robot, p.merged ? "merged" : "NOT merged", core::ToString(p.verdict),
+                  p.hypotheses, p.refuted, p.leader.agreement_m, p.leader.constraint_m, p.leader.conflict_m,
+                  p.rival.agreement_m, p.rival_from_symmetry ? " (symmetry)" : "", wrong_here);
     }
   }
   std::printf("data exchanged: %.3f MB in total, %llu messages malformed\n", mb,

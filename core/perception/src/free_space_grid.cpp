@@ -21,6 +21,7 @@ Status FreeSpaceGrid::Init(const FreeSpaceGridConfig& config) {
   const auto n = static_cast<std::size_t>(config.width) * static_cast<std::size_t>(config.height);
   free_.assign(n, 0);
   occupied_.assign(n, 0);
+  clear_low_.assign(n, 0);
   outside_ = 0;
   return Ok();
 }
@@ -28,6 +29,7 @@ Status FreeSpaceGrid::Init(const FreeSpaceGridConfig& config) {
 void FreeSpaceGrid::Clear() {
   std::fill(free_.begin(), free_.end(), 0);
   std::fill(occupied_.begin(), occupied_.end(), 0);
+  std::fill(clear_low_.begin(), clear_low_.end(), 0);
   outside_ = 0;
 }
 
@@ -55,15 +57,27 @@ FreeSpaceGrid::Cell FreeSpaceGrid::state(int x, int y) const {
   return Cell::kUnknown;
 }
 
-void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free) {
+bool FreeSpaceGrid::ever_occupied(int x, int y) const {
+  if (x < 0 || y < 0 || x >= config_.width || y >= config_.height) return false;
+  return occupied_[static_cast<std::size_t>(y) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x)] > 0;
+}
+
+bool FreeSpaceGrid::clear_below_sensor(int x, int y, unsigned min_rays) const {
+  if (x < 0 || y < 0 || x >= config_.width || y >= config_.height) return false;
+  return clear_low_[static_cast<std::size_t>(y) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x)] >=
+         min_rays;
+}
+
+void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending) {
   const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0);
   const int sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
   int err = dx + dy;
   for (;;) {
     const bool end = x0 == x1 && y0 == y1;
     if (end && !mark_end_free) break;
-    auto& f = free_[static_cast<std::size_t>(y0) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x0)];
-    if (f < 0xFFFF) ++f;
+    const std::size_t k = static_cast<std::size_t>(y0) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x0);
+    if (free_[k] < 0xFFFF) ++free_[k];
+    if (descending && clear_low_[k] < 0xFFFF) ++clear_low_[k];
     if (end) break;
     const int e2 = 2 * err;
     if (e2 >= dy) {
@@ -93,11 +107,12 @@ void FreeSpaceGrid::Integrate(const Eigen::Vector3f& sensor, std::span<const Eig
     }
     const float h = p.z() - floor_z;
     if (h >= config_.obstacle_min_height_m && h <= config_.obstacle_max_height_m) {
-      Ray(sx, sy, x, y, false);
+      Ray(sx, sy, x, y, false, p.z() < sensor.z());
       auto& o = occupied_[static_cast<std::size_t>(y) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x)];
       if (o < 0xFFFF) ++o;
     } else {
-      Ray(sx, sy, x, y, h < config_.obstacle_min_height_m);  // a floor hit is free itself
+      // A floor hit is free itself.
+      Ray(sx, sy, x, y, h < config_.obstacle_min_height_m, p.z() < sensor.z());
     }
   }
 }

@@ -26,6 +26,7 @@
 #include "CollabMessagesPubSubTypes.h"
 #include "TelemetryPubSubTypes.h"
 #include "msgraphs/base/byte_order.hpp"
+#include "msgraphs/core/collab/free_space_codec.hpp"
 #include "msgraphs/platform/clock.hpp"
 
 namespace msgraphs::runtime::link {
@@ -39,10 +40,11 @@ namespace {
 constexpr int kTelemetry = core::kCollabMessageTypes;  // index of the telemetry topic's stats
 constexpr const char* kTopicNames[core::kCollabMessageTypes + 1] = {
     "msgraphs/graph", "msgraphs/room_descriptor", "msgraphs/room_cloud_request",
-    "msgraphs/room_cloud", "msgraphs/telemetry"};
+    "msgraphs/room_cloud", "msgraphs/free_space", "msgraphs/telemetry"};
 // Flow controller priorities (-10 highest): liveness first, then what unblocks a peer's
 // matching, then state, then bulk.
-constexpr const char* kPriorities[core::kCollabMessageTypes + 1] = {"0", "2", "-5", "5", "-10"};
+constexpr const char* kPriorities[core::kCollabMessageTypes + 1] = {"0", "2", "-5", "5", "3", "-10"};
+constexpr int kFreeSpaceTopic = static_cast<int>(core::CollabMessageType::kFreeSpace);
 constexpr const char* kFlowController = "msgraphs_radio";
 constexpr const char* kParticipantPrefix = "msgraphs_robot_";
 
@@ -184,6 +186,7 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
   idl::RoomDescriptorSample out_descriptor, in_descriptor;
   idl::RoomCloudRequestSample out_request, in_request;
   idl::RoomCloudSample out_cloud, in_cloud;
+  idl::FreeSpaceSample out_free, in_free;
 
   ~Impl() override {
     if (participant == nullptr) return;
@@ -374,6 +377,16 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
             out.to = in_cloud.addressee();
           }
           break;
+        case core::CollabMessageType::kFreeSpace:
+          if (reader->take_next_sample(&in_free, &info) != ReturnCode_t::RETCODE_OK) return false;
+          if (!info.valid_data) continue;
+          admitted = Admit(t, info, in_free.version(), in_free.robot_id(), 0, in_free.payload());
+          if (admitted) {
+            copy(in_free.payload());
+            out.from = in_free.robot_id();
+            out.to = 0;
+          }
+          break;
       }
       if (admitted) {
         out.type = static_cast<core::CollabMessageType>(t);
@@ -408,8 +421,10 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
       new CountingType<idl::RoomCloudRequestSamplePubSubType>(&impl->undecodable[2]));
   impl->types[3] =
       dds::TypeSupport(new CountingType<idl::RoomCloudSamplePubSubType>(&impl->undecodable[3]));
-  impl->types[4] =
-      dds::TypeSupport(new CountingType<idl::TelemetryPubSubType>(&impl->undecodable[4]));
+  impl->types[kFreeSpaceTopic] =
+      dds::TypeSupport(new CountingType<idl::FreeSpaceSamplePubSubType>(&impl->undecodable[kFreeSpaceTopic]));
+  impl->types[kTelemetry] =
+      dds::TypeSupport(new CountingType<idl::TelemetryPubSubType>(&impl->undecodable[kTelemetry]));
   impl->publisher = impl->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   impl->subscriber = impl->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (impl->publisher == nullptr || impl->subscriber == nullptr)
@@ -423,7 +438,7 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
         kTopicNames[i], impl->types[i].get_type_name(), dds::TOPIC_QOS_DEFAULT);
     if (topic == nullptr) return Error{Errc::kIo, "cannot create a DDS topic"};
 
-    const bool state = t == 0 || t == 1 || t == kTelemetry;  // late joiners need it
+    const bool state = t == 0 || t == 1 || t == kFreeSpaceTopic || t == kTelemetry;  // late joiners need it
     dds::DataWriterQos w = dds::DATAWRITER_QOS_DEFAULT;
     w.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     w.reliability().max_blocking_time = ToDds(0.1);
@@ -437,7 +452,8 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
                         : t == 2 ? 16
                         : t == 3 ? 8
                                  : 1;
-    // Descriptors: one instance per own room; telemetry and graph: one instance (this robot).
+    // Descriptors: one instance per own room; telemetry, graph and free space: one instance
+    // (this robot).
     w.resource_limits().max_instances = t == 1 ? 256 : 1;
     w.resource_limits().max_samples_per_instance = w.history().depth;
     w.resource_limits().max_samples = w.resource_limits().max_instances * w.history().depth;
@@ -467,8 +483,8 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
       // max_samples >= max_instances x max_samples_per_instance.
       r.history().kind = dds::KEEP_ALL_HISTORY_QOS;
       const std::int32_t depth = static_cast<std::int32_t>(settings.reader_depth);
-      const std::int32_t instances = t == 0 ? 32 : t == 1 ? 4096 : 1;
-      const std::int32_t per_instance = t == 0 ? std::min(depth, 64) : t == 1 ? 2 : depth;
+      const std::int32_t instances = t == 0 || t == kFreeSpaceTopic ? 32 : t == 1 ? 4096 : 1;
+      const std::int32_t per_instance = t == 0 ? std::min(depth, 64) : t == 1 || t == kFreeSpaceTopic ? 2 : depth;
       r.resource_limits().max_instances = instances;
       r.resource_limits().max_samples_per_instance = per_instance;
       r.resource_limits().max_samples = instances * per_instance;
@@ -486,6 +502,7 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
   impl->out_descriptor.robot_id(id);
   impl->out_request.robot_id(id);
   impl->out_cloud.robot_id(id);
+  impl->out_free.robot_id(id);
   return std::unique_ptr<FleetLink>(new FleetLink(std::move(impl)));
 }
 
@@ -535,6 +552,13 @@ void FleetLink::Send(core::CollabMessageType type,
         auto header = core::PeekRoomCloudHeader(bytes);
         m.out_cloud.room_id(header ? header->room : 0);
         ok = m.writers[t]->write(&m.out_cloud);
+        break;
+      }
+      case core::CollabMessageType::kFreeSpace: {
+        fill(m.out_free);
+        auto header = core::PeekFreeSpaceHeader(bytes);
+        m.out_free.space_version(header ? header->version : 0);
+        ok = m.writers[t]->write(&m.out_free);
         break;
       }
     }

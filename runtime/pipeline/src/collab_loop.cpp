@@ -47,10 +47,11 @@ void Node::Impl::CollabLoop() {
         // Malformed messages are counted by the session (per peer) and dropped here.
         if (session.Receive(message.type, message.bytes, *link)) {
           changed = true;
-          // Peers' graphs and descriptors into the checkpoint; requests are answered already
-          // and clouds are asked for again when needed.
+          // Peers' graphs, descriptors and free space into the checkpoint; requests are
+          // answered already and clouds are asked for again when needed.
           if (message.type == core::CollabMessageType::kDistilledGraph ||
-              message.type == core::CollabMessageType::kRoomDescriptor)
+              message.type == core::CollabMessageType::kRoomDescriptor ||
+              message.type == core::CollabMessageType::kFreeSpace)
             Journal([&](JournalWriter& j) {
               return static_cast<bool>(j.Message(message.type, message.bytes));
             });
@@ -65,7 +66,17 @@ void Node::Impl::CollabLoop() {
     if (before_match >= next_match) {
       next_match = before_match + match_period;
       std::lock_guard<std::mutex> lock(session_mutex);
-      origins_changed = session.Match(*link);
+      origins_changed = session.Match(*link, (before_match - started).seconds());
+      // The decisions it logged, kept for merge_log.csv.
+      for (std::size_t n = 0; (n = session.MergeLog(merge_log_sequence, merge_log_scratch)) > 0;) {
+        for (std::size_t i = 0; i < n; ++i) {
+          if (merge_log.size() < kMaxMergeLog)
+            merge_log.push_back(merge_log_scratch[i]);
+          else
+            ++merge_log_dropped;
+        }
+        merge_log_sequence = merge_log_scratch[n - 1].sequence;
+      }
       changed = pending_change;
       pending_change = false;
       if ((changed || origins_changed) && config.feedback) {

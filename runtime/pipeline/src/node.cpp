@@ -99,6 +99,8 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
   m.priors_mailbox.resize(config.mapper.max_plane_priors);
   m.priors_scratch.resize(config.mapper.max_plane_priors);
   m.priors_scratch_collab.resize(config.mapper.max_plane_priors);
+  m.merge_log.reserve(Impl::kMaxMergeLog);
+  m.merge_log_scratch.resize(64);
   m.unpublished_keyframes.reserve(4096);
   if (config.pace == config::Pace::kRecorded)
     m.replay_clock = std::make_unique<ReplayClock>(config.speed);

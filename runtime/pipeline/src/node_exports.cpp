@@ -5,7 +5,9 @@
 // - collab_graph.csv: the collaborative S-Graph as this robot sees it, in its map frame: every
 //   robot's origin, the walls (with their extents) and rooms of itself and of every robot it
 //   merged, and the accepted room matches (what tools/eval draws);
-// - collab_graph.g2o: the same graph for g2o tools (format in docs/runtime.md).
+// - collab_graph.g2o: the same graph for g2o tools (format in docs/runtime.md);
+// - merge_log.csv: every merge decision the session logged, with its evidence and its strongest
+//   rival (docs/multi-robot.md, "The merge rule").
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -148,6 +150,27 @@ void Node::Impl::WriteExports() {
     std::error_code ec;
     fs::rename(temp, final_path, ec);
   };
+  write("merge_log.csv", [&](std::ostream& out) {
+    out << "# robot " << config.robot.value
+        << "'s merge decisions: seconds since the node started, the peer, what changed, the rule's "
+           "verdict, the leading transform (peer's map in ours), its evidence (m), the strongest "
+           "standing rival's\n"
+           "sequence,time_s,peer,event,verdict,x,y,z,yaw_rad,agreement_m,constraint_m,conflict_m,"
+           "rival_agreement_m,rival_constraint_m,rival_conflict_m,rival_from_symmetry,symmetric,"
+           "hypotheses,refuted\n";
+    std::lock_guard<std::mutex> lock(session_mutex);
+    for (const core::MergeLogEntry& e : merge_log) {
+      const Eigen::Vector3d& t = e.T_self_peer.translation();
+      const Eigen::Vector3d x = e.T_self_peer.linear().col(0);
+      out << e.sequence << ',' << e.now_s << ',' << e.peer << ',' << core::ToString(e.event) << ",\""
+          << core::ToString(e.verdict) << "\"," << t.x() << ',' << t.y() << ',' << t.z() << ','
+          << std::atan2(x.y(), x.x()) << ',' << e.leader.agreement_m << ',' << e.leader.constraint_m << ','
+          << e.leader.conflict_m << ',' << e.rival.agreement_m << ',' << e.rival.constraint_m << ','
+          << e.rival.conflict_m << ',' << (e.rival_from_symmetry ? 1 : 0) << ',' << (e.symmetric ? 1 : 0)
+          << ',' << e.hypotheses << ',' << e.refuted << '\n';
+    }
+    if (merge_log_dropped > 0) out << "# " << merge_log_dropped << " later decisions not kept\n";
+  });
   write("collab_graph.csv", [&](std::ostream& out) {
     out << "# the collaborative S-Graph as robot " << config.robot.value
         << " sees it, in its map frame (m, rad)\n"

@@ -119,6 +119,11 @@ struct Node::Impl {
   // Wall priors computed by the collab thread, applied by the SLAM thread at its next exchange.
   std::mutex priors_mutex;
   std::vector<core::PlanePrior> priors_mailbox, priors_scratch, priors_scratch_collab;
+  // Every merge decision the session logged (drained after each Match, written at exit as
+  // merge_log.csv); beyond kMaxMergeLog they are counted, not kept.
+  static constexpr std::size_t kMaxMergeLog = 65536;
+  std::vector<core::MergeLogEntry> merge_log, merge_log_scratch;
+  std::uint64_t merge_log_sequence = 0, merge_log_dropped = 0;
   std::size_t priors_count = 0;
   std::uint64_t priors_generation = 0;
   std::uint64_t applied_priors_generation = 0;  ///< SLAM thread only

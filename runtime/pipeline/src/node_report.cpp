@@ -113,19 +113,18 @@ void Node::Impl::PrintReport() {
               "%.2f, %.2f) m\n",
               p.robot, p.merged ? "merged" : "NOT merged", p.walls, p.rooms, p.consistent,
               p.matches, T.translation().x(), T.translation().y(), T.translation().z());
-      if (p.hypotheses > 1) {
-        Appendf(text,
-                "    %zu competing hypotheses%s: %zu matches with walls agreeing along %.1f m, "
-                "the best rival %zu along %.1f m\n",
-                p.hypotheses, p.undecided ? ", none clearly better (waiting)" : "",
-                p.hypothesis_matches[0], p.agreement_m[0], p.hypothesis_matches[1],
-                p.agreement_m[1]);
-      }
       Appendf(text,
-              "    received: graph %s, descriptors %s, requests %s, clouds %s; malformed %" PRIu64
+              "    decision: %s; %zu hypotheses (%zu refuted); leader: walls agree along %.1f m "
+              "(%.1f m in its weakest direction), %.1f m in conflict with free space; rival: %.1f m%s\n",
+              core::ToString(p.verdict), p.hypotheses, p.refuted, p.leader.agreement_m,
+              p.leader.constraint_m, p.leader.conflict_m, p.rival.agreement_m,
+              p.rival_from_symmetry ? " (a symmetry of one map)" : "");
+      Appendf(text,
+              "    received: graph %s, descriptors %s, requests %s, clouds %s, free space %s; malformed %" PRIu64
               ", graph gaps %" PRIu64 "\n",
               Kilobytes(p.bytes_received[0]).c_str(), Kilobytes(p.bytes_received[1]).c_str(),
               Kilobytes(p.bytes_received[2]).c_str(), Kilobytes(p.bytes_received[3]).c_str(),
+              Kilobytes(p.bytes_received[4]).c_str(),
               p.malformed, p.graph_gaps);
     }
     Appendf(text,
@@ -137,15 +136,20 @@ void Node::Impl::PrintReport() {
     Appendf(text,
             "  collab decoders refused %" PRIu64 " messages (malformed, CRC, unknown format)\n",
             cs.malformed);
-    Appendf(text, "  sent: graph %s, descriptors %s, requests %s, clouds %s\n",
+    Appendf(text, "  sent: graph %s, descriptors %s, requests %s, clouds %s, free space %s\n",
             Kilobytes(cs.bytes_sent[0]).c_str(), Kilobytes(cs.bytes_sent[1]).c_str(),
-            Kilobytes(cs.bytes_sent[2]).c_str(), Kilobytes(cs.bytes_sent[3]).c_str());
+            Kilobytes(cs.bytes_sent[2]).c_str(), Kilobytes(cs.bytes_sent[3]).c_str(),
+            Kilobytes(cs.bytes_sent[4]).c_str());
+    Appendf(text,
+            "  merge decisions: %" PRIu64 " taken, %" PRIu64 " merges, %" PRIu64 " revised, %" PRIu64
+            " undone, %" PRIu64 " logged\n",
+            cs.decisions, cs.merges, cs.revised, cs.undone, cs.log_entries);
   }
   const link::LinkStats ls = link->stats();
   std::uint64_t rejected[4] = {};
   std::uint64_t lost = 0, write_failures = 0;
   std::string lost_topics;
-  const char* topic_names[] = {"graph", "descriptors", "requests", "clouds", "telemetry"};
+  const char* topic_names[] = {"graph", "descriptors", "requests", "clouds", "free space", "telemetry"};
   for (std::size_t i = 0; i < ls.topics.size(); ++i) {
     if (ls.topics[i].lost == 0) continue;
     lost_topics += std::string(lost_topics.empty() ? " (" : ", ") + topic_names[i] + " " +
@@ -199,11 +203,11 @@ void Node::Impl::PrintReport() {
   {
     std::lock_guard<std::mutex> lock(session_mutex);
     const core::CollabSessionStats& cs = session.stats();
-    std::uint64_t received[4] = {};
+    std::uint64_t received[core::kCollabMessageTypes] = {};
     std::size_t merged = 0;
     for (std::size_t i = 0; i < session.peers(); ++i) {
       const core::CollabPeerStats p = session.peer_stats(i);
-      for (int k = 0; k < 4; ++k) received[k] += p.bytes_received[k];
+      for (int k = 0; k < core::kCollabMessageTypes; ++k) received[k] += p.bytes_received[k];
       if (p.merged) ++merged;
     }
     Appendf(stats,
@@ -216,8 +220,10 @@ void Node::Impl::PrintReport() {
             "\nmatches_accepted %" PRIu64 "\n",
             cs.proposals, cs.rejected_fine, cs.rejected_anchored, cs.rejected_consistency,
             cs.accepted);
-    const char* kinds[] = {"graph", "descriptors", "requests", "clouds"};
-    for (int k = 0; k < 4; ++k) {
+    Appendf(stats, "merge_decisions %" PRIu64 "\nmerges %" PRIu64 "\nmerges_revised %" PRIu64
+            "\nmerges_undone %" PRIu64 "\n", cs.decisions, cs.merges, cs.revised, cs.undone);
+    const char* kinds[] = {"graph", "descriptors", "requests", "clouds", "free_space"};
+    for (int k = 0; k < core::kCollabMessageTypes; ++k) {
       Appendf(stats, "sent_%s_bytes %" PRIu64 "\nreceived_%s_bytes %" PRIu64 "\n", kinds[k],
               cs.bytes_sent[k], kinds[k], received[k]);
     }

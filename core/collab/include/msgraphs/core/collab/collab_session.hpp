@@ -9,8 +9,12 @@
 //   is counted by type and dropped). A room cloud request is answered at once.
 // - Match(): proposes room pairs by Scan Context distance, requests the peer's room cloud for
 //   fine alignment (modes with fine alignment), aligns when it has arrived, checks candidates
-//   of anchored robot pairs against the merged estimate, keeps the largest mutually consistent
-//   set of matches per peer and solves the collaborative graph when they changed.
+//   of anchored robot pairs against the merged estimate; then decides, per peer, whether and how
+//   its map is merged (the merge rule, merge_rule.hpp: every hypothesis from the two maps'
+//   corners, rooms and room matches, scored by the walls they lay on each other and refuted by
+//   the free space each robot saw, kept only without a standing rival), logs every change of
+//   decision with its evidence and rivals (MergeLog), and solves the collaborative graph when a
+//   merge or a merged map changed. A merge that later evidence contradicts is undone.
 //
 // Bounded: every store is sized at Init (capacities in CollabSessionConfig; the byte figure is
 // in stats()). Full stores refuse with a counter: a peer beyond max_peers is ignored, a room
@@ -25,8 +29,10 @@
 #include <span>
 
 #include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/collab/alignment_search.hpp"
 #include "msgraphs/core/collab/distiller.hpp"
-#include "msgraphs/core/collab/hypothesis_check.hpp"
+#include "msgraphs/core/collab/free_space_summary.hpp"
+#include "msgraphs/core/collab/merge_rule.hpp"
 #include "msgraphs/core/collab/room_descriptor.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
@@ -40,8 +46,9 @@ enum class CollabMessageType : std::uint8_t {
   kRoomDescriptor = 1,
   kRoomCloudRequest = 2,
   kRoomCloud = 3,
+  kFreeSpace = 4,  ///< the free-space summary (free_space_codec.hpp)
 };
-inline constexpr int kCollabMessageTypes = 4;
+inline constexpr int kCollabMessageTypes = 5;
 const char* CollabMessageTypeName(CollabMessageType type);
 
 /// The paper's ablation modes.
@@ -99,9 +106,24 @@ struct CollabSessionConfig {
   DistillerConfig distiller;
   RoomDescriptorConfig descriptor;
   RoomMatchConfig matcher;
-  HypothesisCheckConfig hypotheses;  ///< competing consistent sets, told apart by the walls
+  FreeSpaceSummaryConfig free_space;
+  /// The summary is sent again when this share of its cells changed since the last one sent.
+  double free_space_resend_share = 0.02;
+  AlignmentSearchConfig search;
+  MergeRuleConfig merge;
+  /// With fewer than two room matches the merge agrees with, the walls the merge lays on each
+  /// other along at least this tie the maps (wall-to-wall factors).
+  double wall_pair_min_overlap_m = 1.0;
+  std::size_t max_log = 512;  ///< merge decisions kept (the oldest give way, counted)
   CollaborativeGraphConfig graph;
   Status Validate() const;
+};
+
+/// The evidence behind one hypothesis, as the decision saw it.
+struct MergeEvidence {
+  double agreement_m = 0, constraint_m = 0, conflict_m = 0;
+  std::uint32_t votes = 0;
+  std::uint8_t sources = 0;  ///< HypothesisSource bits
 };
 
 struct CollabPeerStats {
@@ -109,15 +131,17 @@ struct CollabPeerStats {
   bool merged = false;
   std::uint32_t graph_version = 0;
   std::size_t walls = 0, rooms = 0, descriptors = 0;
-  std::size_t matches = 0, consistent = 0;
-  /// Competing consistent sets of matches (hypotheses of the map-to-map transform), and whether
-  /// none of them is clearly better (the robot is then not merged: it waits for more).
-  std::size_t hypotheses = 0;
-  bool undecided = false;
-  /// Metres of wall that agree under the chosen set (the first when undecided) and under its
-  /// best rival (0 without one): WallAgreement_m.
-  double agreement_m[2] = {};
-  std::size_t hypothesis_matches[2] = {};  ///< the sizes of those two sets
+  std::size_t matches = 0, consistent = 0;  ///< room matches, and those the merge agrees with
+  bool has_free_space = false;
+  /// The last decision: its verdict, the hypotheses scored (and refuted), the leader and the
+  /// strongest standing rival (rival.agreement_m 0 without one).
+  MergeVerdict verdict = MergeVerdict::kNoHypothesis;
+  std::size_t hypotheses = 0, refuted = 0;
+  bool undecided = false;  ///< not merged although a leader exists (a rival, too little, ...)
+  bool symmetric = false, rival_from_symmetry = false;
+  MergeEvidence leader, rival;
+  std::uint64_t merges = 0, undone = 0, revised = 0;
+  double first_merge_s = -1;  ///< the `now_s` of the Match that first merged it (-1: never)
   std::uint64_t bytes_received[kCollabMessageTypes] = {};
   std::uint64_t messages_received[kCollabMessageTypes] = {};
   std::uint64_t malformed = 0;   ///< rejected by a decoder, any type
@@ -135,7 +159,13 @@ struct CollabSessionStats {
   std::uint64_t checked_anchored = 0, rejected_anchored = 0;
   std::uint64_t rejected_consistency = 0;  ///< currently outside the consistent sets
   std::uint64_t accepted = 0;              ///< currently inside them
-  std::uint64_t undecided = 0;  ///< peers with competing hypotheses and none clearly better
+  std::uint64_t undecided = 0;  ///< peers with a leader but no merge (at the last decisions)
+  std::uint64_t decisions = 0, merges = 0, undone = 0, revised = 0;
+  std::uint64_t searches = 0, searches_truncated = 0;
+  /// At the last solve: rooms tied room to room, walls tied wall to wall, fine alignments used.
+  std::size_t solve_room_pairs = 0, solve_wall_pairs = 0, solve_origin_measurements = 0;
+  std::uint64_t free_space_sent = 0, free_space_build_failures = 0;
+  std::uint64_t log_entries = 0, log_dropped = 0;
   std::uint64_t solves = 0, solve_failures = 0;
   /// Distillations with marginal wall covariances, and those that fell back to conditional ones.
   std::uint64_t marginal_updates = 0, marginal_failures = 0;
@@ -151,6 +181,25 @@ struct CollabSessionStats {
   std::uint64_t cloud_encoding_fallbacks = 0;  ///< room clouds sent in 16 bits: too wide for 8
   std::uint64_t malformed = 0;
   std::size_t store_bytes = 0;
+};
+
+/// kMerged: a peer placed; kRevised: placed elsewhere; kUndone: contradicted, no longer placed;
+/// kKept: still placed although a rival now stands (one that does not beat it); kUndecided: not
+/// placed, for a new reason.
+enum class MergeEvent : std::uint8_t { kMerged, kRevised, kUndone, kKept, kUndecided };
+const char* ToString(MergeEvent event);
+
+/// One change of a peer's merge decision, with its evidence and its strongest rival.
+struct MergeLogEntry {
+  std::uint64_t sequence = 0;  ///< 1, 2, ... over the session
+  double now_s = 0;            ///< the caller's clock at that Match
+  std::uint16_t peer = 0;
+  MergeEvent event = MergeEvent::kUndecided;
+  MergeVerdict verdict = MergeVerdict::kNoHypothesis;
+  Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();  ///< the leader's transform
+  MergeEvidence leader, rival;
+  bool has_rival = false, rival_from_symmetry = false, symmetric = false;
+  std::size_t hypotheses = 0, refuted = 0;
 };
 
 class CollabSession {
@@ -172,8 +221,9 @@ class CollabSession {
   /// A message from the link. Malformed ones return the decoder's error and are counted.
   Status Receive(CollabMessageType type, std::span<const std::uint8_t> bytes, CollabOutbox& out);
 
-  /// Proposes, aligns, checks and solves; returns true when the estimate of an origin changed.
-  bool Match(CollabOutbox& out);
+  /// Proposes, aligns, decides and solves; returns true when a room match was added. `now_s`
+  /// (any clock of the caller's) stamps the decisions it logs.
+  bool Match(CollabOutbox& out, double now_s = 0);
 
   const DistilledGraph& distilled() const;
   bool merged(std::uint16_t robot) const;
@@ -190,6 +240,12 @@ class CollabSession {
   /// priors that feed the collaborative estimate back into the local S-Graph
   /// (LocalMapper::SetPlanePriors). Returns how many were written into `out`.
   std::size_t PlanePriors(std::span<PlanePrior> out) const;
+
+  /// Merge decisions with sequence > `after`, oldest first, into `out`; returns how many. The log
+  /// keeps the newest max_log entries (stats().log_dropped counts the rest).
+  std::size_t MergeLog(std::uint64_t after, std::span<MergeLogEntry> out) const;
+  /// This robot's free-space summary as last built (empty before the first Publish).
+  const FreeSpaceSummary& free_space() const;
 
   std::size_t peers() const;
   CollabPeerStats peer_stats(std::size_t index) const;

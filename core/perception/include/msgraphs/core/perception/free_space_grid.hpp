@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
 // A bounded 2-D free-space grid accumulated from keyframes (the part of voxblox's ESDF that
 // room segmentation needs): every lidar ray marks the cells it crosses free; points in the
-// obstacle height band mark their cell occupied. Fixed size and origin from configuration;
+// obstacle height band mark their cell occupied. Rays that descend from the sensor (towards a
+// point below it) also mark the cells they cross clear below the sensor: no obstacle as tall
+// as the sensor stands there, since it would have stopped the ray; rays that pass over a box
+// towards the ceiling say nothing of that kind (`clear_below_sensor`). Fixed size and origin from configuration;
 // points outside the grid are counted and ignored. Integrate allocates nothing.
 #pragma once
 
@@ -36,6 +39,12 @@ class FreeSpaceGrid {
   void Integrate(const Eigen::Vector3f& sensor, std::span<const Eigen::Vector3f> points, float floor_z);
 
   Cell state(int x, int y) const;
+  /// True when any return in the obstacle band ever fell in the cell (whatever rays crossed it
+  /// since: rays passing over a low obstacle towards the ceiling do not make it free here). For
+  /// evidence that must not call an obstacle free.
+  bool ever_occupied(int x, int y) const;
+  /// True when at least `min_rays` descending rays crossed the cell (see the header comment).
+  bool clear_below_sensor(int x, int y, unsigned min_rays = 1) const;
   bool ToCell(const Eigen::Vector2d& p, int& x, int& y) const;
   Eigen::Vector2d CellCentre(int x, int y) const;
   int width() const { return config_.width; }
@@ -45,11 +54,12 @@ class FreeSpaceGrid {
   void Clear();
 
  private:
-  void Ray(int x0, int y0, int x1, int y1, bool mark_end_free);
+  void Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending);
 
   FreeSpaceGridConfig config_;
   std::vector<std::uint16_t> free_;
   std::vector<std::uint16_t> occupied_;
+  std::vector<std::uint16_t> clear_low_;
   std::uint64_t outside_ = 0;
 };
 

@@ -87,7 +87,7 @@ struct TopicStats {
 };
 
 struct LinkStats {
-  /// [0..3] by core::CollabMessageType, [4] telemetry.
+  /// [0..4] by core::CollabMessageType, [5] telemetry.
   std::array<TopicStats, core::kCollabMessageTypes + 1> topics{};
   std::uint64_t robots_appeared = 0, robots_vanished = 0;
 };

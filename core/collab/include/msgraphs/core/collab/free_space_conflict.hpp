@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// Negative evidence for a transform between two maps: what one robot mapped, laid into the
+// other's frame, where the other robot saw something else.
+// - A wall in seen-through space: samples of robot x's walls that fall at least `clearance_m`
+//   inside robot y's free space (FreeSpaceSummary::clearance_m), except across y's openings (a
+//   wall over a doorway is its lintel).
+// - An opening on a solid wall: samples of x's openings that fall on cells y saw occupied next
+//   to one of y's walls, away from y's own openings; counted when they cover at least
+//   `door_solid_share` of the opening (a correct transform leaves the jambs, a fraction of it).
+// Both are lengths in metres; the merge rule compares them with its thresholds (merge_rule.hpp).
+// No allocation.
+#pragma once
+
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/collab/free_space_summary.hpp"
+#include "msgraphs/core/collab/planar_transform.hpp"
+#include "msgraphs/core/collab/wall_index.hpp"
+
+namespace msgraphs::core {
+
+struct FreeSpaceConflictConfig {
+  /// Beyond the first ring of free cells (0.2 m cells: their centres lie 0.1 m from the edge of
+  /// free space, the next ring's 0.3 m): a wall exactly on the other robot's wall may fall in the
+  /// free cell next to it (the summary's quantisation), and a correct transform is good to a few
+  /// centimetres.
+  double clearance_m = 0.3;
+  double sample_step_m = 0.1;
+  /// An opening this close is the same opening; a wall sample this close to one is its lintel.
+  double opening_margin_m = 0.3;
+  double door_solid_share = 0.6;
+  double door_wall_distance_m = 0.3;  ///< an occupied cell this close to a wall line is that wall
+  Status Validate() const;
+};
+
+struct FreeSpaceConflict {
+  double walls_in_free_m = 0;
+  double openings_on_solid_m = 0;
+  double total_m() const { return walls_in_free_m + openings_on_solid_m; }
+};
+
+/// Robot x's walls and openings (x's frame), laid into robot y's frame by T_y_x, against y's
+/// summary and walls.
+FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& summary_x,
+                             const PlanarTransform& T_y_x, const WallIndex& walls_y,
+                             const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& config);
+
+}  // namespace msgraphs::core

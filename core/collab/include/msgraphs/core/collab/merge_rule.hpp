@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+// The merge decision: whether robot b's map is placed in robot a's, and by which transform.
+// Safe by construction: a merge needs positive evidence, no contradiction, and no standing
+// alternative; otherwise the pair stays undecided and the decision says why.
+//
+// Given every hypothesis of the alignment search (alignment_search.hpp), best wall agreement
+// first, with its conflicts in both directions (free_space_conflict.hpp):
+// 1. A hypothesis with more than `refute_conflict_m` of conflict is refuted: one robot mapped a
+//    wall (or saw through an opening) where the other saw through (or saw a solid wall).
+// 2. The leader is the first hypothesis not refuted. It must agree along at least
+//    `min_agreement_m` of wall and `min_constraint_m` in its weakest direction (two directions
+//    fixed, not a corridor's slide), and its own conflict must be at most `accept_conflict_m`.
+// 3. Every other hypothesis not refuted that constrains both directions at least
+//    `min_rival_constraint_m` is a rival; the leader must beat each by the margin:
+//    agreement >= margin_ratio * rival's + margin_m.
+// 4. Symmetry: each map's own symmetries (the alignment search of a map with itself: a row of
+//    identical rooms, a room's half turn) composed with the leader give alternatives that lay b
+//    on another copy of the same structure. If one of them is not refuted, the structure the
+//    robots share repeats and the difference in agreement may be nothing but which copy each
+//    robot saw more of: the margin becomes `symmetric_margin_ratio`, and the alternative is a
+//    rival too.
+// Then: merge with the leader. A merged pair is kept while its hypothesis is not refuted and no
+// rival beats it by the margin (hysteresis: accept at accept_conflict_m, undo beyond
+// refute_conflict_m).
+//
+// Why this does not merge wrongly (docs/multi-robot.md, "The merge rule"): a wrong transform
+// that wins must (a) contradict nothing either robot saw, (b) lay walls on walls in two
+// directions, and (c) beat the true transform, which the search proposes whenever the robots
+// share a corner or a room, by the margin. In a building that does not repeat, (a) fails for
+// the wrong transform as soon as the maps overlap beyond the shared structure; where it
+// repeats, (c) fails, because the true transform then stands as a rival.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/collab/alignment_search.hpp"
+#include "msgraphs/core/collab/free_space_conflict.hpp"
+#include "msgraphs/core/collab/free_space_summary.hpp"
+#include "msgraphs/core/collab/wall_index.hpp"
+
+namespace msgraphs::core {
+
+struct MergeRuleConfig {
+  double min_agreement_m = 8.0;
+  double min_constraint_m = 3.0;
+  double accept_conflict_m = 0.4;
+  double refute_conflict_m = 0.8;
+  double min_rival_constraint_m = 1.0;
+  double margin_ratio = 1.5;
+  double margin_m = 3.0;
+  double symmetric_margin_ratio = 3.0;
+  std::size_t max_symmetries = 16;  ///< each map's strongest symmetries composed with the leader
+  FreeSpaceConflictConfig conflict;
+  Status Validate() const;
+};
+
+enum class MergeVerdict : std::uint8_t {
+  kNoFreeSpace,   ///< a robot's free-space summary is missing: no negative evidence, no merge
+  kNoHypothesis,  ///< nothing aligns two walls of each map yet
+  kRefuted,       ///< every hypothesis contradicts what a robot saw
+  kInsufficient,  ///< the leader agrees too little (or in one direction only)
+  kConflicted,    ///< the leader contradicts a little: not refuted, not acceptable
+  kAmbiguous,     ///< a rival stands within the margin
+  kTruncated,     ///< the search lost candidates (a bounded store was full)
+  kMerge,
+};
+const char* ToString(MergeVerdict verdict);
+
+struct MergeDecision {
+  MergeVerdict verdict = MergeVerdict::kNoHypothesis;
+  Hypothesis leader, rival;         ///< rival: the strongest standing one (when there is one)
+  bool has_leader = false, has_rival = false;
+  bool rival_from_symmetry = false;  ///< the rival is a symmetry of one map composed with the leader
+  bool symmetric = false;            ///< a symmetry alternative stands: the wider margin applied
+  bool keeping = false;     ///< the leader is the current merge (hysteresis applied)
+  bool overturned = false;  ///< kAmbiguous while merged, and the rival beats the current merge
+  std::size_t hypotheses = 0, refuted = 0;
+};
+
+/// Everything the rule looks at for one robot pair. `sym_a`, `sym_b`: the maps' own symmetries
+/// (AlignmentSearch::Search of a map with itself), strongest first.
+struct MergeInputs {
+  const WallIndex* walls_a = nullptr;
+  const WallIndex* walls_b = nullptr;
+  const FreeSpaceSummary* free_a = nullptr;
+  const FreeSpaceSummary* free_b = nullptr;
+  std::span<Hypothesis> hypotheses;  ///< conflicts are filled in as the rule needs them
+  bool truncated = false;
+  std::span<const Hypothesis> sym_a, sym_b;
+};
+
+/// Decides. `search` evaluates the symmetry alternatives. `current` (optional): the transform
+/// the pair is merged with now, which keeps the merge under the hysteresis rule.
+MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const MergeRuleConfig& config,
+                          const PlanarTransform* current);
+
+/// Fills h's conflicts (both directions).
+void MeasureConflict(Hypothesis& h, const MergeInputs& in, const FreeSpaceConflictConfig& config);
+
+}  // namespace msgraphs::core

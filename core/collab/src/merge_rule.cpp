@@ -1,0 +1,162 @@
+// SPDX-License-Identifier: MIT
+#include "msgraphs/core/collab/merge_rule.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+bool Standing(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.refute_conflict_m; }
+
+bool Beats(const Hypothesis& leader, const Hypothesis& rival, double ratio, const MergeRuleConfig& c) {
+  return leader.agreement.agreement_m >= ratio * rival.agreement.agreement_m + c.margin_m;
+}
+
+}  // namespace
+
+const char* ToString(MergeVerdict v) {
+  switch (v) {
+    case MergeVerdict::kNoFreeSpace:
+      return "no free-space summary yet";
+    case MergeVerdict::kNoHypothesis:
+      return "no hypothesis";
+    case MergeVerdict::kRefuted:
+      return "every hypothesis refuted by free space";
+    case MergeVerdict::kInsufficient:
+      return "too little agreement";
+    case MergeVerdict::kConflicted:
+      return "leader contradicts observed free space";
+    case MergeVerdict::kAmbiguous:
+      return "a rival stands within the margin";
+    case MergeVerdict::kTruncated:
+      return "search truncated (a bounded store was full)";
+    case MergeVerdict::kMerge:
+      return "merge";
+  }
+  return "unknown";
+}
+
+Status MergeRuleConfig::Validate() const {
+  if (!(min_agreement_m > 0) || !(min_constraint_m > 0) || !(accept_conflict_m >= 0) ||
+      !(refute_conflict_m >= accept_conflict_m) || !(min_rival_constraint_m > 0) || !(margin_ratio >= 1) ||
+      !(margin_m >= 0) || !(symmetric_margin_ratio >= margin_ratio)) {
+    return Error{Errc::kInvalidConfig,
+                 "merge rule: positive evidence thresholds, accept <= refute, margins >= 1 and ordered"};
+  }
+  return conflict.Validate();
+}
+
+void MeasureConflict(Hypothesis& h, const MergeInputs& in, const FreeSpaceConflictConfig& c) {
+  if (h.conflict_known) return;
+  h.conflict_b_in_a = ConflictOf(*in.walls_b, *in.free_b, h.T_a_b, *in.walls_a, *in.free_a, c);
+  h.conflict_a_in_b = ConflictOf(*in.walls_a, *in.free_a, h.T_a_b.inverse(), *in.walls_b, *in.free_b, c);
+  h.conflict_known = true;
+}
+
+MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const MergeRuleConfig& c,
+                          const PlanarTransform* current) {
+  MergeDecision out;
+  out.hypotheses = in.hypotheses.size();
+  if (in.truncated) {
+    out.verdict = MergeVerdict::kTruncated;
+    return out;
+  }
+  if (in.hypotheses.empty()) return out;
+  const FreeSpaceConflictConfig& cc = c.conflict;
+  // The leader: the merged transform when it still stands (hysteresis), else the best standing.
+  const double same_m = search.config().same_distance_m, same_rad = search.config().same_angle_rad;
+  int leader = -1;
+  Hypothesis L;
+  bool keeping = false;
+  if (current != nullptr) {
+    for (std::size_t i = 0; i < in.hypotheses.size() && leader < 0; ++i) {
+      Hypothesis& h = in.hypotheses[i];
+      if (!SameTransform(h.T_a_b, *current, 2 * same_m, 2 * same_rad)) continue;
+      MeasureConflict(h, in, cc);
+      if (Standing(h, c)) leader = static_cast<int>(i);
+    }
+    if (leader >= 0) {
+      L = in.hypotheses[static_cast<std::size_t>(leader)];
+      keeping = true;
+    } else {
+      // No longer proposed (its walls changed): judged as it is.
+      Hypothesis h = search.Evaluate(*in.walls_a, *in.walls_b, *current);
+      MeasureConflict(h, in, cc);
+      if (Standing(h, c) && h.agreement.constraint_m >= c.min_rival_constraint_m) {
+        L = h;
+        keeping = true;
+      }
+    }
+  }
+  if (!keeping) {
+    for (std::size_t i = 0; i < in.hypotheses.size() && leader < 0; ++i) {
+      MeasureConflict(in.hypotheses[i], in, cc);
+      if (Standing(in.hypotheses[i], c)) leader = static_cast<int>(i);
+    }
+    if (leader >= 0) L = in.hypotheses[static_cast<std::size_t>(leader)];
+  }
+  for (const Hypothesis& h : in.hypotheses) out.refuted += h.conflict_known && !Standing(h, c) ? 1u : 0u;
+  if (leader < 0 && !keeping) {
+    out.verdict = MergeVerdict::kRefuted;
+    return out;
+  }
+  out.leader = L;
+  out.has_leader = true;
+  out.keeping = keeping;
+  if (!keeping) {
+    if (L.agreement.agreement_m < c.min_agreement_m || L.agreement.constraint_m < c.min_constraint_m) {
+      out.verdict = MergeVerdict::kInsufficient;
+      return out;
+    }
+    if (L.conflict_m() > c.accept_conflict_m) {
+      out.verdict = MergeVerdict::kConflicted;
+      return out;
+    }
+  }
+  // Symmetry alternatives: each map's symmetry composed with the leader.
+  Hypothesis best_symmetric;
+  bool has_symmetric = false;
+  auto consider = [&](const PlanarTransform& T) {
+    if (SameTransform(T, L.T_a_b, same_m, same_rad)) return;
+    Hypothesis h = search.Evaluate(*in.walls_a, *in.walls_b, T);
+    if (SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) return;
+    if (h.agreement.constraint_m < c.min_rival_constraint_m) return;
+    MeasureConflict(h, in, cc);
+    if (!Standing(h, c)) return;
+    h.sources |= kFromSymmetry;
+    if (!has_symmetric || h.agreement.agreement_m > best_symmetric.agreement.agreement_m) best_symmetric = h;
+    has_symmetric = true;
+  };
+  for (std::size_t k = 0; k < in.sym_a.size() && k < c.max_symmetries; ++k) consider(in.sym_a[k].T_a_b * L.T_a_b);
+  for (std::size_t k = 0; k < in.sym_b.size() && k < c.max_symmetries; ++k) consider(L.T_a_b * in.sym_b[k].T_a_b);
+  out.symmetric = has_symmetric;
+  const double ratio = has_symmetric ? c.symmetric_margin_ratio : c.margin_ratio;
+  // The strongest standing rival among the hypotheses (they are sorted by agreement: the first
+  // that stands and constrains both directions is the strongest).
+  for (std::size_t i = 0; i < in.hypotheses.size(); ++i) {
+    if (static_cast<int>(i) == leader) continue;
+    Hypothesis& h = in.hypotheses[i];
+    if (h.agreement.constraint_m < c.min_rival_constraint_m) continue;
+    if (SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) continue;
+    // Below what could block even at the wider margin: no later one can either.
+    if (h.agreement.agreement_m * c.symmetric_margin_ratio + c.margin_m <= L.agreement.agreement_m) break;
+    MeasureConflict(h, in, cc);
+    if (!Standing(h, c)) continue;
+    out.rival = h;
+    out.has_rival = true;
+    break;
+  }
+  if (has_symmetric && (!out.has_rival || best_symmetric.agreement.agreement_m > out.rival.agreement.agreement_m)) {
+    out.rival = best_symmetric;
+    out.has_rival = true;
+    out.rival_from_symmetry = true;
+  }
+  if (out.has_rival && !Beats(L, out.rival, ratio, c)) {
+    out.verdict = MergeVerdict::kAmbiguous;
+    // A merge is undone when a rival now beats it by the margin, not merely when one stands.
+    out.overturned = keeping && Beats(out.rival, L, c.margin_ratio, c);
+    return out;
+  }
+  out.verdict = MergeVerdict::kMerge;
+  return out;
+}
+
+}  // namespace msgraphs::core

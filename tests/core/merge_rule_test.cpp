@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: MIT
+// The merge decision on planned buildings (plan_building.hpp): the alignment search proposes the
+// truth, free space refutes what contradicts it, repeated structure stays undecided until
+// something unique is seen, a single shared room merges, disjoint views do not.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+
+#include "alloc_counter.hpp"
+#include "msgraphs/core/collab/alignment_search.hpp"
+#include "msgraphs/core/collab/free_space_codec.hpp"
+#include "msgraphs/core/collab/merge_rule.hpp"
+#include "plan_building.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+using test::PlanBuilding;
+using test::Pose2;
+using test::Seen;
+
+constexpr double kPi = std::numbers::pi;
+
+// A 60 m corridor with ten identical 6 x 5 m rooms on its south side, each door 1 m wide at the
+// same place: the symmetry trap. Space 0 is the corridor, room k is space k + 1.
+PlanBuilding IdenticalRooms() {
+  PlanBuilding b;
+  b.spaces.push_back({0, 0, 60, 2.4});
+  for (int k = 0; k < 10; ++k) {
+    b.spaces.push_back({6.0 * k + 0.075, -5, 6.0 * k + 6 - 0.075, -0.15});
+    b.doors.push_back({{6.0 * k + 1, -0.075}, {6.0 * k + 2, -0.075}, 0, k + 1});
+  }
+  return b;
+}
+
+// Rooms of different widths along a corridor, doors 0.8 m from their west walls.
+PlanBuilding VariedRooms() {
+  PlanBuilding b;
+  b.spaces.push_back({0, 0, 30, 2.4});
+  double x = 0;
+  int k = 1;
+  for (double width : {4.0, 5.0, 3.5, 6.0, 4.5, 5.5}) {
+    b.spaces.push_back({x + 0.075, -5, x + width - 0.075, -0.15});
+    b.doors.push_back({{x + 0.8, -0.075}, {x + 1.7, -0.075}, 0, k++});
+    x += width;
+  }
+  return b;
+}
+
+struct Robot {
+  Eigen::Isometry2d T_map_world;
+  DistilledGraph graph;
+  WallIndex walls;
+  FreeSpaceSummary free;
+  AlignmentSearch self;  // its symmetries
+
+  Robot(const PlanBuilding& b, const std::vector<Seen>& seen, const Eigen::Isometry2d& T) : T_map_world(T) {
+    graph = b.Walls(seen, T);
+    EXPECT_TRUE(walls.Init(256));
+    walls.Build(graph.walls.span(), 0.5);
+    FreeSpaceSummaryConfig fc;
+    fc.max_cells = 1 << 19;
+    EXPECT_TRUE(free.Init(fc));
+    b.Summary(seen, T, free);
+    EXPECT_TRUE(self.Init({}));
+    self.Search(walls, {}, walls, {}, {}, true);
+  }
+};
+
+// What robot a decides about robot b.
+MergeDecision Decide(Robot& a, Robot& b, AlignmentSearch& search, const PlanarTransform* current = nullptr) {
+  search.Search(a.walls, {}, b.walls, {}, {}, false);
+  MergeInputs in;
+  in.walls_a = &a.walls;
+  in.walls_b = &b.walls;
+  in.free_a = &a.free;
+  in.free_b = &b.free;
+  in.hypotheses = search.hypotheses();
+  in.truncated = search.truncated();
+  in.sym_a = a.self.hypotheses();
+  in.sym_b = b.self.hypotheses();
+  const MergeDecision d = DecideMerge(in, search, MergeRuleConfig{}, current);
+  if (std::getenv("MERGE_DEBUG") != nullptr) {
+    const auto show = [](const char* what, const Hypothesis& h) {
+      std::printf("  %s: yaw %.3f t (%.2f %.2f) agreement %.2f constraint %.2f conflict b>a %.2f+%.2f a>b %.2f+%.2f votes %u src %u\n",
+                  what, h.T_a_b.yaw_rad, h.T_a_b.t_m.x(), h.T_a_b.t_m.y(), h.agreement.agreement_m,
+                  h.agreement.constraint_m, h.conflict_b_in_a.walls_in_free_m, h.conflict_b_in_a.openings_on_solid_m,
+                  h.conflict_a_in_b.walls_in_free_m, h.conflict_a_in_b.openings_on_solid_m, h.votes, h.sources);
+    };
+    std::printf("verdict %s, %zu hypotheses, %zu refuted, symmetric %d, corners %zu/%zu clusters %zu kept %zu\n", ToString(d.verdict),
+                d.hypotheses, d.refuted, d.symmetric, search.stats().corners_a, search.stats().corners_b,
+                search.stats().clusters, search.stats().kept);
+    if (d.has_leader) show("leader", d.leader);
+    if (d.has_rival) show(d.rival_from_symmetry ? "rival (symmetry)" : "rival", d.rival);
+    for (std::size_t i = 0; i < std::min<std::size_t>(6, search.hypotheses().size()); ++i) show("h", search.hypotheses()[i]);
+  }
+  return d;
+}
+
+PlanarTransform Truth(const Robot& a, const Robot& b) {
+  const Eigen::Isometry2d T = a.T_map_world * b.T_map_world.inverse();
+  return {std::atan2(T.linear()(1, 0), T.linear()(0, 0)), T.translation()};
+}
+
+void ExpectNear(const PlanarTransform& estimate, const PlanarTransform& truth) {
+  if (std::getenv("MERGE_DEBUG") != nullptr)
+    std::printf("  truth: yaw %.3f t (%.2f %.2f)\n", truth.yaw_rad, truth.t_m.x(), truth.t_m.y());
+  EXPECT_NEAR(std::remainder(estimate.yaw_rad - truth.yaw_rad, 2 * kPi), 0.0, 0.005);
+  EXPECT_LT((estimate.t_m - truth.t_m).norm(), 0.05);
+}
+
+TEST(MergeRule, IdenticalRoomsStayUndecidedUntilSomethingUniqueIsSeen) {
+  const PlanBuilding building = IdenticalRooms();
+  const Eigen::Isometry2d Ta = Pose2(-20, 3, 0.7), Tb = Pose2(10, -40, -2.1);
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  {
+    // a walked the corridor from x = 8 to 30 past rooms 2-4, b from 14 to 36 past rooms 3-5: the
+    // view shifted by one room fits even better than the truth.
+    Robot a(building, {{0, 8, 30}, {3}, {4}, {5}}, Ta);
+    Robot b(building, {{0, 14, 36}, {4}, {5}, {6}}, Tb);
+    const MergeDecision d = Decide(a, b, search);
+    EXPECT_EQ(d.verdict, MergeVerdict::kAmbiguous) << ToString(d.verdict);
+    EXPECT_TRUE(d.has_rival);
+  }
+  {
+    // Both saw the corridor's west end: every shifted view puts an end wall in the other's
+    // corridor.
+    Robot a(building, {{0, 0, 30}, {1}, {2}, {3}, {4}, {5}}, Ta);
+    Robot b(building, {{0, 0, 36}, {3}, {4}, {5}, {6}}, Tb);
+    const MergeDecision d = Decide(a, b, search);
+    ASSERT_EQ(d.verdict, MergeVerdict::kMerge) << ToString(d.verdict);
+    ExpectNear(d.leader.T_a_b, Truth(a, b));
+  }
+}
+
+TEST(MergeRule, APairSharingOneRoomMerges) {
+  const PlanBuilding building = VariedRooms();
+  // a saw rooms 1-3 and the corridor up to x = 14; b rooms 3-5 and the corridor from x = 9.
+  Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));
+  Robot b(building, {{0, 9, 30}, {3}, {4}, {5}}, Pose2(-25, 4, -0.4));
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  const MergeDecision d = Decide(a, b, search);
+  ASSERT_EQ(d.verdict, MergeVerdict::kMerge) << ToString(d.verdict);
+  ExpectNear(d.leader.T_a_b, Truth(a, b));
+  // And b about a, the same transform the other way.
+  const MergeDecision back = Decide(b, a, search);
+  ASSERT_EQ(back.verdict, MergeVerdict::kMerge) << ToString(back.verdict);
+  ExpectNear(back.leader.T_a_b, Truth(b, a));
+}
+
+TEST(MergeRule, OneRoomAloneMergesWhenItsDoorBreaksTheSymmetry) {
+  PlanBuilding building;
+  building.spaces.push_back({0, 0, 4, 5});
+  building.spaces.push_back({0, 5.15, 4, 7.55});  // the corridor outside, never entered
+  building.doors.push_back({{0.6, 5.075}, {1.5, 5.075}, 0, 1});
+  Robot a(building, {{0}}, Pose2(1, 2, 0.4));
+  Robot b(building, {{0}}, Pose2(-6, 1, 1.9));
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  const MergeDecision d = Decide(a, b, search);
+  // The half turn lays the room on itself but puts each robot's door on the other's wall.
+  ASSERT_EQ(d.verdict, MergeVerdict::kMerge) << ToString(d.verdict);
+  ExpectNear(d.leader.T_a_b, Truth(a, b));
+
+  // With a second door opposite the first, the room is symmetric: nothing can tell.
+  building.doors.push_back({{2.5, -0.075}, {3.4, -0.075}, 0, 1});
+  Robot c(building, {{0}}, Pose2(1, 2, 0.4));
+  Robot e(building, {{0}}, Pose2(-6, 1, 1.9));
+  const MergeDecision s = Decide(c, e, search);
+  EXPECT_EQ(s.verdict, MergeVerdict::kAmbiguous) << ToString(s.verdict);
+}
+
+TEST(MergeRule, DisjointViewsDoNotMerge) {
+  const PlanBuilding building = VariedRooms();
+  Robot a(building, {{0, 0, 9}, {1}, {2}}, Pose2(0, 0, 0.3));
+  Robot b(building, {{0, 18.5, 30}, {5}, {6}}, Pose2(4, 4, 1.2));
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  const MergeDecision d = Decide(a, b, search);
+  EXPECT_NE(d.verdict, MergeVerdict::kMerge) << ToString(d.verdict);
+}
+
+TEST(MergeRule, AMergeContradictedLaterIsOverturned) {
+  const PlanBuilding building = IdenticalRooms();
+  const Eigen::Isometry2d Ta = Pose2(-20, 3, 0.7), Tb = Pose2(10, -40, -2.1);
+  Robot a(building, {{0, 0, 30}, {1}, {2}, {3}, {4}, {5}}, Ta);
+  Robot b(building, {{0, 0, 36}, {3}, {4}, {5}, {6}}, Tb);
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  // Merged one room off (as the identical rooms could have made it): b's west end wall lies in
+  // a's corridor, so the merge cannot stand.
+  const PlanarTransform truth = Truth(a, b);
+  const PlanarTransform shifted = PlanarTransform{0, a.T_map_world.linear() * Eigen::Vector2d(6, 0)} * truth;
+  const MergeDecision d = Decide(a, b, search, &shifted);
+  EXPECT_FALSE(d.keeping);
+  ASSERT_EQ(d.verdict, MergeVerdict::kMerge);
+  ExpectNear(d.leader.T_a_b, truth);
+}
+
+TEST(MergeRule, DecidingAllocatesNothing) {
+  const PlanBuilding building = VariedRooms();
+  Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));
+  Robot b(building, {{0, 9, 30}, {3}, {4}, {5}}, Pose2(-25, 4, -0.4));
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  Decide(a, b, search);  // warm-up
+  test::AllocationScope scope;
+  const MergeDecision d = Decide(a, b, search);
+  EXPECT_EQ(scope.allocations(), 0u);
+  EXPECT_EQ(d.verdict, MergeVerdict::kMerge);
+}
+
+TEST(FreeSpaceCodec, RoundTripAndRefusals) {
+  const PlanBuilding building = VariedRooms();
+  Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));
+  std::vector<std::uint8_t> bytes(1 << 20);
+  auto n = EncodeFreeSpace({7, 42}, a.free, bytes);
+  ASSERT_TRUE(n);
+  EXPECT_LT(*n, 2000u);  // runs compress a building's cells
+  bytes.resize(*n);
+  FreeSpaceSummary back;
+  FreeSpaceSummaryConfig fc;
+  fc.max_cells = 1 << 19;
+  ASSERT_TRUE(back.Init(fc));
+  auto h = DecodeFreeSpace(bytes, back);
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->robot, 7);
+  EXPECT_EQ(h->version, 42u);
+  ASSERT_EQ(back.cells(), a.free.cells());
+  EXPECT_TRUE(std::equal(back.raw().begin(), back.raw().end(), a.free.raw().begin()));
+  EXPECT_EQ(back.openings().size(), a.free.openings().size());
+  EXPECT_EQ(back.free_cells(), a.free.free_cells());
+  // Every byte flipped somewhere is refused (CRC), truncations are refused, a re-sealed body with
+  // a wrong run count is refused.
+  for (std::size_t i = 0; i < bytes.size(); i += 7) {
+    std::vector<std::uint8_t> bad = bytes;
+    bad[i] ^= 0x20;
+    EXPECT_FALSE(DecodeFreeSpace(bad, back));
+  }
+  for (std::size_t len : {std::size_t{0}, std::size_t{10}, bytes.size() - 1})
+    EXPECT_FALSE(DecodeFreeSpace(std::span(bytes.data(), len), back));
+  // A grid beyond the receiver's capacity.
+  FreeSpaceSummary small;
+  FreeSpaceSummaryConfig sc;
+  sc.max_cells = 64;
+  ASSERT_TRUE(small.Init(sc));
+  auto e = DecodeFreeSpace(bytes, small);
+  ASSERT_FALSE(e);
+  EXPECT_EQ(e.error().code, Errc::kCapacityExceeded);
+}
+
+}  // namespace
+}  // namespace msgraphs::core
