@@ -107,5 +107,5 @@ sleep 0.5
 [[ $rc -eq 0 ]] || { echo "a node failed: see $out/logs"; }
 echo
 "$bin/tools/msgraphs_fleet_report" --out "$out/nodes" --dest "$out" --run "$run" --view 1 \
-  ${offsets[@]+"${offsets[@]}"} --max-dt-s $([[ $inputs == udp ]] && echo 0.02 || echo 0.006) || rc=1
+  ${offsets[@]+"${offsets[@]}"} || rc=1
 exit $rc

@@ -3,7 +3,8 @@
 // records two robots, msgraphs_collab runs both local S-Graphs, distils and exchanges through
 // the wire encodings, matches rooms with fine alignment and the consistency check, and solves
 // robot 1's collaborative graph. Checked here: robot 2 is merged, no accepted match is wrong
-// against the truth, and robot 2's keyframes land on the ground truth in robot 1's frame.
+// against the truth, both views (1 of 2, 2 of 1) are merged and right in the text and the JSON
+// summary, and robot 2's keyframes land on the ground truth in robot 1's frame.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -11,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include "msgraphs/tools/ate.hpp"
+#include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "tool_process.hpp"
 
@@ -27,7 +30,7 @@ TEST(CollabSim, TwoRobotsMergeWithoutAWrongRoomMatch) {
       0);
   ASSERT_EQ(Wait(Spawn({"/bin/sh", "-c",
                         std::string(MSGRAPHS_COLLAB_TOOL) + " --run " + run + " --out " + out +
-                            " > " + log})),
+                            " --summary " + out + "/summary.json > " + log})),
             0);
   std::ifstream in(log);
   std::stringstream text;
@@ -35,6 +38,19 @@ TEST(CollabSim, TwoRobotsMergeWithoutAWrongRoomMatch) {
   std::printf("%s", text.str().c_str());
   EXPECT_NE(text.str().find("robot 1 merged 2 of 2 robots"), std::string::npos);
   EXPECT_NE(text.str().find(" 0 of them wrong against the truth"), std::string::npos);
+  // Every view, not only robot 1's: both merged, both origins right, in the text and the summary.
+  EXPECT_NE(text.str().find("views: 2 of 2 merged; 2 right, 0 wrong, 0 unchecked, 0 not merged"),
+            std::string::npos);
+  std::ifstream summary_file(out + "/summary.json");
+  std::stringstream summary;
+  summary << summary_file.rdbuf();
+  EXPECT_NE(summary.str().find("\"schema\": \"msgraphs_collab_summary\""), std::string::npos);
+  std::size_t right = 0;
+  for (std::size_t at = 0;
+       (at = summary.str().find("\"verdict\": \"right\"", at)) != std::string::npos; ++at)
+    ++right;
+  EXPECT_EQ(right, 2u);
+  EXPECT_GT(tools::ReadTum(out + "/robot1_in_robot2.tum").size(), 50u);
   // Robot 2's keyframes in robot 1's frame, against robot 2's truth in the world: the same rigid
   // alignment that puts robot 1 on its truth must put robot 2 on its own.
   const auto truth1 = tools::ReadTum(run + "/robot1/ground_truth.tum");
@@ -42,15 +58,17 @@ TEST(CollabSim, TwoRobotsMergeWithoutAWrongRoomMatch) {
   const auto est1 = tools::ReadTum(out + "/robot1_in_robot1.tum");
   const auto est2 = tools::ReadTum(out + "/robot2_in_robot1.tum");
   ASSERT_GT(est2.size(), 50u);
-  const auto ate1 = tools::ComputeAte(est1, truth1, 0.006);
+  const auto ate1 = tools::ComputeAte(est1, truth1);
   ASSERT_TRUE(ate1.ok);
+  EXPECT_EQ(ate1.pairs.paired, est1.size()) << ate1.pairs.DescribeUnpaired();
+  const tools::PairedPoses paired2 = tools::PairWithTruth(est2, tools::TruthTrajectory(truth2));
+  EXPECT_EQ(paired2.counts.paired, est2.size()) << paired2.counts.DescribeUnpaired();
   double sum2 = 0;
-  std::size_t n = 0;
-  for (const auto& p : est2) {
-    if (const auto* t = tools::Nearest(truth2, p.t, 0.006)) {
-      sum2 += (ate1.T_truth_estimate * p.T.translation() - t->T.translation()).squaredNorm();
-      ++n;
-    }
+  const std::size_t n = paired2.estimate.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    sum2 += (ate1.T_truth_estimate * paired2.estimate[i].T.translation() -
+             paired2.truth[i].T.translation())
+                .squaredNorm();
   }
   ASSERT_GT(n, 50u);
   const double rmse2 = std::sqrt(sum2 / static_cast<double>(n));

@@ -3,18 +3,24 @@
 // folder a user opens in the tools of the field, with a short report per robot.
 //
 //   msgraphs_fleet_report --out NODES --dest DIR [--run RUN] [--view 1] [--offset K=SECONDS]...
-//                         [--max-dt-s 0.02] [--expect-merged]
+//                         [--max-dt-s S] [--expect-merged]
 //
 // NODES/robotK/ holds each node's outputs (keyframes.tum, origins.csv, map.pcd,
 // collab_graph.csv, stats.txt); RUN/robotK/ground_truth.tum the simulator's truth (optional:
 // without it no ATE). --offset K=S: robot K's node stamped its inputs on arrival (live UDP), S
 // seconds after the recording's clock (msgraphs_replay prints it); its keyframes are brought
-// back to the recording's clock. Writes, in robot V's (--view) map frame:
+// back to the recording's clock. Every keyframe is scored against its robot's truth interpolated
+// at its stamp (tools/truth_pairing.hpp; --max-dt-s S: optional stricter limit, a truth sample
+// within S seconds); keyframes without truth are counted with the reason. Writes, in robot V's
+// (--view) map frame:
 //   DIR/robotK.tum          every robot's keyframes (TUM, recording clock: evo reads them)
 //   DIR/merged_map.pcd      every robot's map.pcd laid out by V's estimate of its origin
 //   DIR/collab_graph.svg    walls, rooms, room matches and every trajectory, seen from above
 //   DIR/report.txt          the report printed on stdout
-// Exit 1 when an input is missing, or with --expect-merged when V did not merge every robot.
+// Exit 1 when an input is missing (a robot of RUN without keyframes.tum included), with --run
+// when a robot's own ATE or V's aggregated ATE cannot be computed (a robot without truth at its
+// keyframes is reported, never left out), or with --expect-merged when V did not merge every
+// robot.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -30,6 +36,9 @@
 #include <vector>
 
 #include "msgraphs/runtime/outputs/pcd_file.hpp"
+#include "msgraphs/tools/aggregated_ate.hpp"
+#include "msgraphs/tools/ate.hpp"
+#include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 
 namespace {
@@ -41,7 +50,7 @@ struct Options {
   std::string nodes, dest, run;
   int view = 1;
   std::map<int, double> offset_s;
-  double max_dt_s = 0.02;
+  double max_dt_s = 0;  ///< optional stricter pairing limit; 0: none
   bool expect_merged = false;
 };
 
@@ -86,14 +95,20 @@ bool ReadCollabGraph(const fs::path& path, CollabGraph& g) {
     if (f[0] == "origin" && f.size() == 10) {
       Origin o;
       o.merged = num(2) != 0;
-      o.T.linear() = Eigen::Quaterniond(num(9), num(6), num(7), num(8)).normalized().toRotationMatrix();
+      o.T.linear() =
+          Eigen::Quaterniond(num(9), num(6), num(7), num(8)).normalized().toRotationMatrix();
       o.T.translation() << num(3), num(4), num(5);
       g.origins[static_cast<int>(num(1))] = o;
     } else if (f[0] == "wall" && f.size() == 11) {
       g.walls.push_back({static_cast<int>(num(1)), {num(3), num(4)}, {num(5), num(6)}});
     } else if (f[0] == "room" && f.size() == 10) {
-      g.rooms.push_back({static_cast<int>(num(1)), static_cast<int>(num(2)), {num(3), num(4)},
-                         num(6), num(7), num(8), num(9) != 0});
+      g.rooms.push_back({static_cast<int>(num(1)),
+                         static_cast<int>(num(2)),
+                         {num(3), num(4)},
+                         num(6),
+                         num(7),
+                         num(8),
+                         num(9) != 0});
     } else if (f[0] == "match" && f.size() == 5) {
       g.matches.push_back({static_cast<int>(num(1)), static_cast<int>(num(2)),
                            static_cast<int>(num(3)), static_cast<int>(num(4))});
@@ -122,7 +137,9 @@ double WallWidth(int robot) { return std::max(1.5, 6.5 - 1.75 * robot); }
 
 // Top-down picture of the collaborative S-Graph in the view's frame: 1 m = `scale` px, x right,
 // y up; walls per robot's colour, rooms as their wall-to-wall boxes, matched rooms joined.
-bool WriteSvg(const fs::path& path, int view, const CollabGraph& g,
+bool WriteSvg(const fs::path& path,
+              int view,
+              const CollabGraph& g,
               const std::map<int, std::vector<StampedPose>>& trajectories) {
   double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
   auto grow = [&](const Eigen::Vector2d& p) {
@@ -136,7 +153,8 @@ bool WriteSvg(const fs::path& path, int view, const CollabGraph& g,
   if (x0 > x1) return false;
   const double scale = 20, margin = 2;
   x0 -= margin, y0 -= margin, x1 += margin, y1 += margin;
-  const int width = static_cast<int>((x1 - x0) * scale), height = static_cast<int>((y1 - y0) * scale);
+  const int width = static_cast<int>((x1 - x0) * scale),
+            height = static_cast<int>((y1 - y0) * scale);
   auto X = [&](double x) { return (x - x0) * scale; };
   auto Y = [&](double y) { return (y1 - y) * scale; };
   std::ofstream out(path);
@@ -157,7 +175,8 @@ bool WriteSvg(const fs::path& path, int view, const CollabGraph& g,
     if (r.corridor) continue;
     const double sx = r.size_x / 2, sy = r.size_y / 2;
     const Eigen::Rotation2Dd R(r.yaw);
-    out << "<polygon fill=\"" << Colour(r.robot) << "\" fill-opacity=\"0.08\" stroke=\"none\" points=\"";
+    out << "<polygon fill=\"" << Colour(r.robot)
+        << "\" fill-opacity=\"0.08\" stroke=\"none\" points=\"";
     for (const auto& c : {Eigen::Vector2d(-sx, -sy), Eigen::Vector2d(sx, -sy),
                           Eigen::Vector2d(sx, sy), Eigen::Vector2d(-sx, sy)}) {
       const Eigen::Vector2d p = r.centre + R * c;
@@ -212,9 +231,10 @@ bool WriteSvg(const fs::path& path, int view, const CollabGraph& g,
         << "\"/><text x=\"42\" y=\"" << y << "\">" << text << "</text>\n";
   };
   for (const auto& [robot, poses] : trajectories) {
-    legend_line(Colour(robot), "robot " + std::to_string(robot) +
-                                   ": walls (solid), rooms (squares, shaded boxes), keyframes (dashed)" +
-                                   (robot == view ? " - the reference frame" : ""));
+    legend_line(Colour(robot),
+                "robot " + std::to_string(robot) +
+                    ": walls (solid), rooms (squares, shaded boxes), keyframes (dashed)" +
+                    (robot == view ? " - the reference frame" : ""));
   }
   legend_line("#a6a6a6", "accepted room matches (grey bars); grid 5 m; seen from above in robot " +
                              std::to_string(view) + "'s map frame");
@@ -227,12 +247,19 @@ bool ParseOptions(int argc, char** argv, Options& o) {
     const std::string a = argv[i];
     auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
     const char* v = nullptr;
-    if (a == "--out" && (v = next())) o.nodes = v;
-    else if (a == "--dest" && (v = next())) o.dest = v;
-    else if (a == "--run" && (v = next())) o.run = v;
-    else if (a == "--view" && (v = next())) o.view = std::atoi(v);
-    else if (a == "--max-dt-s" && (v = next())) o.max_dt_s = std::atof(v);
-    else if (a == "--expect-merged") o.expect_merged = true;
+    if (a == "--out" && (v = next()))
+      o.nodes = v;
+    else if (a == "--dest" && (v = next()))
+      o.dest = v;
+    else if (a == "--run" && (v = next()))
+      o.run = v;
+    else if (a == "--view" && (v = next()))
+      o.view = std::atoi(v);
+    else if (a == "--max-dt-s" && (v = next())) {
+      o.max_dt_s = std::atof(v);
+      if (!(o.max_dt_s >= 0)) return false;
+    } else if (a == "--expect-merged")
+      o.expect_merged = true;
     else if (a == "--offset" && (v = next())) {
       const std::string s = v;
       const auto eq = s.find('=');
@@ -247,7 +274,7 @@ bool ParseOptions(int argc, char** argv, Options& o) {
 
 // printf to stdout and into the report file's text.
 __attribute__((format(printf, 2, 3))) void Say(std::string& report, const char* format, ...) {
-  char line[1024];
+  char line[4096];
   va_list args;
   va_start(args, format);
   std::vsnprintf(line, sizeof line, format, args);
@@ -269,21 +296,36 @@ int main(int argc, char** argv) {
   if (!ParseOptions(argc, argv, o)) {
     std::fprintf(stderr,
                  "usage: msgraphs_fleet_report --out NODES --dest DIR [--run RUN] [--view 1]\n"
-                 "                             [--offset K=SECONDS]... [--max-dt-s 0.02] "
+                 "                             [--offset K=SECONDS]... [--max-dt-s S] "
                  "[--expect-merged]\n");
     return 2;
   }
   std::error_code ec;
   fs::create_directories(o.dest, ec);
-  std::map<int, std::vector<StampedPose>> keyframes, truth;
+  std::map<int, std::vector<StampedPose>> keyframes;
+  std::map<int, msgraphs::tools::TruthTrajectory> truth;
+  msgraphs::tools::PairingConfig pairing;
+  pairing.max_dt_s = o.max_dt_s;
+  bool failed = false;
   for (int k = 1; k <= 64; ++k) {
     const fs::path kf = fs::path(o.nodes) / ("robot" + std::to_string(k)) / "keyframes.tum";
-    if (!fs::exists(kf)) continue;
+    const fs::path gt = fs::path(o.run) / ("robot" + std::to_string(k)) / "ground_truth.tum";
+    const bool have_truth = !o.run.empty() && fs::exists(gt);
+    if (!fs::exists(kf)) {
+      if (have_truth) {
+        // A robot of the mission whose node wrote nothing: listed, never silently absent.
+        std::printf("robot %d: no keyframes.tum in %s (its node wrote nothing)\n", k,
+                    kf.parent_path().c_str());
+        failed = true;
+      }
+      continue;
+    }
     keyframes[k] = msgraphs::tools::ReadTum(kf.string());
     const double offset = o.offset_s.count(k) ? o.offset_s[k] : 0.0;
     for (StampedPose& p : keyframes[k]) p.t -= offset;
-    const fs::path gt = fs::path(o.run) / ("robot" + std::to_string(k)) / "ground_truth.tum";
-    if (!o.run.empty() && fs::exists(gt)) truth[k] = msgraphs::tools::ReadTum(gt.string());
+    if (have_truth)
+      truth.emplace(
+          k, msgraphs::tools::TruthTrajectory(msgraphs::tools::ReadTum(gt.string()), pairing));
   }
   if (!keyframes.count(o.view)) {
     std::fprintf(stderr, "fleet_report: no keyframes.tum of robot %d in %s\n", o.view,
@@ -293,8 +335,7 @@ int main(int argc, char** argv) {
   CollabGraph graph;
   const fs::path view_dir = fs::path(o.nodes) / ("robot" + std::to_string(o.view));
   if (!ReadCollabGraph(view_dir / "collab_graph.csv", graph)) {
-    std::fprintf(stderr, "fleet_report: cannot read %s\n",
-                 (view_dir / "collab_graph.csv").c_str());
+    std::fprintf(stderr, "fleet_report: cannot read %s\n", (view_dir / "collab_graph.csv").c_str());
     return 1;
   }
   std::string report;
@@ -303,23 +344,31 @@ int main(int argc, char** argv) {
   for (const auto& [k, poses] : keyframes) {
     const auto stats = ReadStats(fs::path(o.nodes) / ("robot" + std::to_string(k)) / "stats.txt");
     auto st = [&](const char* key) { return stats.count(key) ? stats.at(key) : 0.0; };
-    std::string ate = "no ground truth";
+    std::string ate = "no ground truth", pairs;
     if (truth.count(k)) {
-      const auto a = msgraphs::tools::ComputeAte(poses, truth[k], o.max_dt_s);
+      const auto a = msgraphs::tools::ComputeAte(poses, truth.at(k));
       if (a.ok) {
         T_world_map[k] = a.T_truth_estimate;
         char b[96];
-        std::snprintf(b, sizeof b, "ATE %.1f cm over %zu keyframes", a.rmse * 100, a.poses);
+        std::snprintf(b, sizeof b, "ATE %.1f cm over %zu keyframes", a.rmse * 100, a.poses());
         ate = b;
       } else {
         ate = std::string("ATE not computed: ") + a.error;
+        failed = true;
       }
+      pairs = "  truth: paired at " + std::to_string(a.pairs.paired) + " of " +
+              std::to_string(poses.size()) + " keyframes (unpaired: " + a.pairs.DescribeUnpaired() +
+              ")\n";
+    } else if (!o.run.empty()) {
+      failed = true;  // asked to score against the truth, and this robot has none
     }
-    Say(report, "robot %d: %s; %.0f walls, %.0f rooms mapped; merged %.0f of %.0f other robots\n", k,
-        ate.c_str(), st("walls"), st("rooms"), st("merged"), st("peers"));
+    Say(report, "robot %d: %s; %.0f walls, %.0f rooms mapped; merged %.0f of %.0f other robots\n",
+        k, ate.c_str(), st("walls"), st("rooms"), st("merged"), st("peers"));
+    if (!pairs.empty()) Say(report, "%s", pairs.c_str());
     const double rejected = st("matches_rejected_fine") + st("matches_rejected_anchored") +
                             st("matches_rejected_consistency");
-    Say(report, "  room matches: %.0f accepted, %.0f rejected (%.0f by fine alignment, %.0f against the "
+    Say(report,
+        "  room matches: %.0f accepted, %.0f rejected (%.0f by fine alignment, %.0f against the "
         "merged estimate, %.0f outside the consistent set) of %.0f proposed\n",
         st("matches_accepted"), rejected, st("matches_rejected_fine"),
         st("matches_rejected_anchored"), st("matches_rejected_consistency"),
@@ -330,54 +379,64 @@ int main(int argc, char** argv) {
         Kb(st("sent_graph_bytes") + st("sent_descriptors_bytes") + st("sent_requests_bytes") +
            st("sent_clouds_bytes"))
             .c_str());
-    Say(report, "  node: keyframe %.1f ms p50, %.1f ms p99; scan queue peak %.0f, %.0f scans dropped; "
+    Say(report,
+        "  node: keyframe %.1f ms p50, %.1f ms p99; scan queue peak %.0f, %.0f scans dropped; "
         "peak RSS %.0f MB\n",
         st("keyframe_p50_ms"), st("keyframe_p99_ms"), st("scan_queue_peak"), st("scans_dropped"),
         st("peak_rss_mb"));
   }
 
-  // Robot V's view: every robot it merged, in its frame.
+  // Robot V's view: every robot it merged, in its frame; every other one listed as missing.
   std::map<int, std::vector<StampedPose>> in_view;
-  std::vector<StampedPose> aggregated, aggregated_truth;
+  msgraphs::tools::AggregatedAteBuilder aggregated;
   std::size_t merged = 0;
   std::string origin_errors;
   for (const auto& [k, poses] : keyframes) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     if (k != o.view) {
       const auto it = graph.origins.find(k);
-      if (it == graph.origins.end() || !it->second.merged) continue;
+      if (it == graph.origins.end() || !it->second.merged) {
+        aggregated.AddNotMerged(k);
+        continue;
+      }
       T = it->second.T;
+      char b[128];
       if (T_world_map.count(k) && T_world_map.count(o.view)) {
         const Eigen::Isometry3d e = (T_world_map[o.view].inverse() * T_world_map[k]).inverse() * T;
-        char b[128];
         std::snprintf(b, sizeof b, "; robot %d's origin off by %.1f cm, %.2f deg", k,
                       e.translation().norm() * 100,
                       Eigen::AngleAxisd(e.linear()).angle() * 180.0 / M_PI);
-        origin_errors += b;
+      } else {
+        std::snprintf(b, sizeof b, "; robot %d's origin not checked (no truth alignment)", k);
       }
+      if (!o.run.empty()) origin_errors += b;
     }
     ++merged;
     auto& out = in_view[k];
-    for (const StampedPose& p : poses) {
-      out.push_back({p.t, T * p.T});
-      if (truth.count(k)) {
-        if (const StampedPose* t = msgraphs::tools::Nearest(truth[k], p.t, o.max_dt_s)) {
-          const double stamp = static_cast<double>(aggregated.size());
-          aggregated.push_back({stamp, T * p.T});
-          aggregated_truth.push_back({stamp, t->T});
-        }
-      }
-    }
+    for (const StampedPose& p : poses) out.push_back({p.t, T * p.T});
+    aggregated.AddMerged(k, out, truth.count(k) ? &truth.at(k) : nullptr);
     msgraphs::tools::WriteTum((fs::path(o.dest) / ("robot" + std::to_string(k) + ".tum")).string(),
                               out);
   }
-  if (!aggregated.empty()) {
-    const auto a = msgraphs::tools::ComputeAte(aggregated, aggregated_truth, 0.5);
-    Say(report, "robot %d's view: %zu of %zu robots in its frame; aggregated ATE %.1f cm over %zu "
-        "keyframes%s\n",
-        o.view, merged, keyframes.size(), a.rmse * 100, a.poses, origin_errors.c_str());
+  if (!o.run.empty()) {
+    const msgraphs::tools::AggregatedAte a = aggregated.Finish();
+    if (a.ok()) {
+      Say(report,
+          "robot %d's view: %zu of %zu robots in its frame; aggregated ATE %.1f cm over %zu "
+          "keyframes%s\n  (%s)\n",
+          o.view, merged, keyframes.size(), a.ate.rmse * 100, a.ate.poses(), origin_errors.c_str(),
+          a.Describe().c_str());
+    } else {
+      Say(report,
+          "robot %d's view: %zu of %zu robots in its frame; aggregated ATE FAILED: %s%s\n"
+          "  (%s)\n",
+          o.view, merged, keyframes.size(), a.failure().c_str(), origin_errors.c_str(),
+          a.Describe().c_str());
+      failed = true;
+    }
   } else {
-    Say(report, "robot %d's view: %zu of %zu robots in its frame\n", o.view, merged, keyframes.size());
+    Say(report, "robot %d's view: %zu of %zu robots in its frame\n", o.view, merged,
+        keyframes.size());
   }
 
   // The merged map: every merged robot's map.pcd in V's frame, one point per 5 cm voxel.
@@ -396,8 +455,7 @@ int main(int argc, char** argv) {
         (k == o.view ? Eigen::Isometry3d::Identity() : graph.origins[k].T).cast<float>();
     for (const Eigen::Vector3f& p : *cloud) {
       const Eigen::Vector3f q = T * p;
-      if (voxels.insert(msgraphs::runtime::VoxelKey(q, 0.05f)).second)
-        points.push_back(q);
+      if (voxels.insert(msgraphs::runtime::VoxelKey(q, 0.05f)).second) points.push_back(q);
     }
   }
   const fs::path merged_pcd = fs::path(o.dest) / "merged_map.pcd";
@@ -411,11 +469,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fleet_report: cannot draw %s\n", svg.c_str());
     return 1;
   }
-  Say(report, "wrote %s: %zu robots' TUM keyframes, merged_map.pcd (%zu maps, %zu points), "
+  Say(report,
+      "wrote %s: %zu robots' TUM keyframes, merged_map.pcd (%zu maps, %zu points), "
       "collab_graph.svg (%zu walls, %zu rooms, %zu room matches)\n",
       o.dest.c_str(), in_view.size(), maps, points.size(), graph.walls.size(), graph.rooms.size(),
       graph.matches.size());
   std::ofstream(fs::path(o.dest) / "report.txt") << report;
   if (o.expect_merged && merged != keyframes.size()) return 1;
-  return 0;
+  return failed ? 1 : 0;
 }

@@ -31,8 +31,9 @@
 #include "msgraphs/drivers/pcap/pcap_reader.hpp"
 #include "msgraphs/drivers/velodyne/data_packet_decoder.hpp"
 #include "msgraphs/drivers/velodyne/device_clock.hpp"
-#include "msgraphs/drivers/velodyne/scan_assembler.hpp"
 #include "msgraphs/drivers/velodyne/recorded_scans.hpp"
+#include "msgraphs/drivers/velodyne/scan_assembler.hpp"
+#include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
 #include "world.hpp"
@@ -143,11 +144,12 @@ int main(int argc, char** argv) {
   for (const auto& room : world->rooms) rects.push_back(sim::MinAreaRectangle(room));
   std::map<std::pair<int, std::size_t>, std::unordered_set<std::uint64_t>> room_voxels;
   double plane_ms = 0;
+  tools::PairCounts truth_of_scans;  // scans placed by the truth, and why not the others
 
   for (int robot = 1; robot <= 10; ++robot) {
     const fs::path dir = fs::path(run) / ("robot" + std::to_string(robot));
     if (!fs::exists(dir / "velodyne.pcap")) break;
-    const auto tum = tools::ReadTum((dir / "ground_truth.tum").string());
+    const tools::TruthTrajectory tum(tools::ReadTum((dir / "ground_truth.tum").string()));
     auto scans = drivers::velodyne::RecordedScans::Open((dir / "velodyne.pcap").string());
     if (!scans) return 1;
     Eigen::Isometry3d last_keyframe = Eigen::Isometry3d::Identity();
@@ -156,7 +158,14 @@ int main(int argc, char** argv) {
       const auto& scan = *next;
       const double t0 = scan.start_time.seconds_since_epoch(),
                    t1 = scan.end_time.seconds_since_epoch();
-      const Eigen::Isometry3d T_world_end = tools::PoseAt(tum, t1) * T_base_lidar;
+      // A sweep is placed only where the truth covers both its ends (no clamping to the ends).
+      const auto truth_start = tum.At(t0), truth_end = tum.At(t1);
+      if (!truth_start.ok || !truth_end.ok) {
+        truth_of_scans.Count(truth_start.ok ? truth_end.reason : truth_start.reason);
+        continue;
+      }
+      ++truth_of_scans.paired;
+      const Eigen::Isometry3d T_world_end = truth_end.T * T_base_lidar;
       if (have_keyframe) {
         const Eigen::Isometry3d delta = last_keyframe.inverse() * T_world_end;
         const double angle = Eigen::AngleAxisd(delta.linear()).angle();
@@ -171,8 +180,7 @@ int main(int argc, char** argv) {
         if (!scan_points.try_push_back(Eigen::Vector3f(p.x_m, p.y_m, p.z_m))) break;
         times[scan_points.size() - 1] = static_cast<float>(p.time_offset_ns * 1e-9);
       }
-      const Eigen::Isometry3d T_start_end =
-          (tools::PoseAt(tum, t0) * T_base_lidar).inverse() * T_world_end;
+      const Eigen::Isometry3d T_start_end = (truth_start.T * T_base_lidar).inverse() * T_world_end;
       static_cast<void>(core::DeskewToEnd(scan_points.span(),
                                           std::span<const float>(times.data(), scan_points.size()),
                                           std::max(1e-3, t1 - t0), T_start_end));
@@ -382,6 +390,8 @@ int main(int argc, char** argv) {
         descriptors.size(), same_sum / std::max<double>(1.0, static_cast<double>(same_n)), same_n,
         sc_below, other_sum / std::max<double>(1.0, static_cast<double>(other_n)), other_n,
         sc_false_below, sc_top1, sc_queries);
+    std::printf("truth placed %zu of %zu scans (unpaired: %s)\n", truth_of_scans.paired,
+                truth_of_scans.total(), truth_of_scans.DescribeUnpaired().c_str());
     std::printf("wall extraction %.1f ms per keyframe; total %.1f s\n",
                 plane_ms / std::max<double>(1, static_cast<double>(keyframes)), seconds);
   }

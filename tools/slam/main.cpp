@@ -3,8 +3,9 @@
 // local S-Graph, as fast as possible in lock-step (odometry is fed up to each scan's end first).
 // Writes the keyframes (TUM, base frame), the encoder odometry at the same stamps (TUM), walls
 // and rooms (CSV), and prints per-stage timing percentiles, peak memory and, when the run
-// directory holds ground truth, the ATE of both against it and the walls and rooms found
-// against the world's truth.
+// directory holds ground truth, the ATE of both against it (truth interpolated at each
+// keyframe's stamp; how many keyframes it paired and why not the others) and the walls and
+// rooms found against the world's truth.
 //
 //   msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] [--max-keyframes N]
 #include <sys/resource.h>
@@ -25,6 +26,8 @@
 #include "msgraphs/drivers/can_odometry/candump_file.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/velodyne/recorded_scans.hpp"
+#include "msgraphs/tools/ate.hpp"
+#include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
 #include "world.hpp"
@@ -77,6 +80,33 @@ class Timer final : public core::StageObserver {
   Clock::time_point start_, last_;
   bool active_ = false;
 };
+
+// "0.021" or "n/a": a failed ATE is never printed as a number.
+std::string AteCell(const tools::AteResult& ate) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", ate.rmse);
+  return ate.ok ? b : "n/a";
+}
+
+// The ATE lines: the figures, and how many keyframes the truth could score and why not the rest.
+void PrintAte(std::size_t keyframes,
+              const tools::TruthTrajectory& truth,
+              const tools::AteResult& slam,
+              const tools::AteResult& odometry) {
+  if (slam.ok && odometry.ok) {
+    std::printf(
+        "ATE RMSE (SE(3) Umeyama, %zu keyframes): S-Graph %.3f m (max %.3f), encoder odometry "
+        "%.3f m (max %.3f)\n",
+        slam.poses(), slam.rmse, slam.max, odometry.rmse, odometry.max);
+  } else {
+    std::printf("ATE not computed: %s\n", slam.ok ? odometry.error : slam.error);
+  }
+  std::printf(
+      "truth paired at %zu of %zu keyframes (unpaired: %s); %zu truth samples, median period "
+      "%.4f s, gap limit %.4f s\n",
+      slam.pairs.paired, keyframes, slam.pairs.DescribeUnpaired().c_str(), truth.samples().size(),
+      truth.median_period_s(), truth.gap_limit_s());
+}
 
 }  // namespace
 
@@ -216,18 +246,25 @@ int main(int argc, char** argv) {
             << r.walls[2] << ',' << r.walls[3] << '\n';
     }
   }
-  const auto truth = tools::ReadTum((dir / "ground_truth.tum").string());
-  const tools::AteResult ate_slam = tools::ComputeAte(slam, truth, 0.006),
-                         ate_odometry = tools::ComputeAte(encoders, truth, 0.006);
+  const tools::TruthTrajectory truth_trajectory(
+      tools::ReadTum((dir / "ground_truth.tum").string()));
+  const std::vector<tools::StampedPose>& truth = truth_trajectory.samples();
+  const tools::AteResult ate_slam = tools::ComputeAte(slam, truth_trajectory),
+                         ate_odometry = tools::ComputeAte(encoders, truth_trajectory);
   if (!out_dir.empty() && ate_slam.ok) {
-    // Per-keyframe error after the alignment, to see where an estimate went wrong.
+    // Per-keyframe error after the alignment, to see where an estimate went wrong; keyframes
+    // without truth are listed in the header with their reasons.
+    const tools::PairedPoses paired = tools::PairWithTruth(slam, truth_trajectory);
     std::ofstream errors(fs::path(out_dir) / "keyframe_errors.txt");
-    for (const tools::StampedPose& e : slam) {
-      if (const tools::StampedPose* t = tools::Nearest(truth, e.t, 0.006)) {
-        errors << std::fixed << e.t << ' '
-               << (ate_slam.T_truth_estimate * e.T.translation() - t->T.translation()).norm()
-               << '\n';
-      }
+    errors << "# stamp error_m; " << paired.counts.paired << " of " << slam.size()
+           << " keyframes paired with the truth (unpaired: " << paired.counts.DescribeUnpaired()
+           << ")\n";
+    for (std::size_t i = 0; i < paired.estimate.size(); ++i) {
+      errors << std::fixed << paired.estimate[i].t << ' '
+             << (ate_slam.T_truth_estimate * paired.estimate[i].T.translation() -
+                 paired.truth[i].T.translation())
+                    .norm()
+             << '\n';
     }
   }
 
@@ -285,10 +322,11 @@ int main(int argc, char** argv) {
   const auto& ms = mapper.stats();
   if (markdown) {
     std::printf(
-        "| %s | %d | %zu | %.3f | %.3f | %zu / %zu | %zu / %zu (%zu visited) | %llu | %.0f | %.1f "
+        "| %s | %d | %zu | %s | %s | %zu / %zu | %zu / %zu (%zu visited) | %llu | %.0f | %.1f "
         "|\n",
-        world ? world->name.c_str() : run.c_str(), robot, slam.size(), ate_odometry.rmse,
-        ate_slam.rmse, walls_true, walls_mapped, rooms_correct, rooms_mapped, rooms_visited,
+        world ? world->name.c_str() : run.c_str(), robot, slam.size(),
+        AteCell(ate_odometry).c_str(), AteCell(ate_slam).c_str(), walls_true, walls_mapped,
+        rooms_correct, rooms_mapped, rooms_visited,
         static_cast<unsigned long long>(ms.loop_closures), Timer::Percentile(timer.total(), 0.5),
         static_cast<double>(usage.ru_maxrss) / 1024.0);
     return 0;
@@ -296,10 +334,7 @@ int main(int argc, char** argv) {
   std::printf("robot %d: %zu scans, %zu keyframes, %.1f s (%.1f x real time)\n", robot, scan_count,
               slam.size(), seconds,
               static_cast<double>(scan_count) * 0.1 / std::max(1e-9, seconds));
-  std::printf(
-      "ATE RMSE (SE(3) Umeyama, %zu keyframes): S-Graph %.3f m (max %.3f), encoder odometry %.3f m "
-      "(max %.3f)\n",
-      ate_slam.poses, ate_slam.rmse, ate_slam.max, ate_odometry.rmse, ate_odometry.max);
+  PrintAte(slam.size(), truth_trajectory, ate_slam, ate_odometry);
   std::printf(
       "graph: %zu keyframes (peak %zu, %zu sparsified), %zu planes, %zu rooms, %zu floor; %zu "
       "factors "

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// msgraphs_collab's command line, and the robots' start delays from the recording's
+// mission.txt (`robot N ... start_delay_s S ...`; an explicit --delay-s N=S overrides it; a
+// missing file or key means no delay).
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "evaluation_config.hpp"
+#include "msgraphs/core/collab/collab_session.hpp"
+
+namespace msgraphs::tools::collab {
+
+struct Options {
+  std::string run, out_dir, summary_path;
+  std::string mode_name = "rooms-walls-fine";
+  std::string cloud_name = "q16";
+  bool keyframes = false;  ///< --mode keyframes: the baseline
+  bool feedback = true;
+  bool markdown = false;
+  double every_s = 10.0;
+  std::map<int, double> delays_s;  ///< --delay-s: robot id -> start delay
+  core::CollabSessionConfig session;
+  EvaluationConfig evaluation;
+};
+
+inline constexpr const char* kUsage =
+    "usage: msgraphs_collab --run DIR [--mode "
+    "rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes]\n"
+    "                       [--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off]\n"
+    "                       [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]...\n"
+    "                       [--wrong-origin-m 0.5]\n"
+    "                       [--wrong-origin-deg 2] [--out DIR] [--summary FILE] [--markdown]\n";
+
+/// False with `error` on a bad command line (the caller prints it and the usage, exit 2).
+bool ParseOptions(int argc, char** argv, Options& o, std::string& error);
+
+struct StartDelay {
+  double delay_s = 0;
+  const char* source = "none";  ///< "none", "mission.txt" or "--delay-s"
+};
+/// Robot `robot`'s start delay: --delay-s when given, else mission.txt's, else none.
+StartDelay ResolveStartDelay(int robot,
+                             const std::map<int, double>& mission_delays_s,
+                             const std::map<int, double>& option_delays_s);
+
+/// Start delay per robot id from `path` (mission.txt). A missing file is no delay (true, empty);
+/// a `start_delay_s` without a valid value (finite, >= 0) is an error (false, `error` set).
+bool ReadStartDelays(const std::string& path, std::map<int, double>& delays_s, std::string& error);
+
+}  // namespace msgraphs::tools::collab
