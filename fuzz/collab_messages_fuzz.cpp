@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: arbitrary bytes as another robot's message. The first byte picks the kind
-// (distilled graph, room descriptor, room cloud, room cloud request); the rest is the message body,
+// (distilled graph, room descriptor, room cloud request, room cloud, free-space summary); the rest
+// is the message body,
 // to which the correct CRC-32 is appended so that the parsers past the checksum are exercised (a
 // wrong CRC alone is rejected at once). Invariants: no crash; whatever decodes is finite, within
-// the receiver's capacity, with unit wall normals, and merges into a copy.
+// the receiver's capacity, with unit wall normals, and merges into a copy; a free-space summary
+// that decodes fills exactly its grid with valid states and finite openings.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <vector>
 
 #include "msgraphs/core/collab/distilled_codec.hpp"
+#include "msgraphs/core/collab/free_space_codec.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
 #include "sealed_message.hpp"
 
@@ -20,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::vector<std::uint8_t> message = SealedMessage(std::span(data + 1, size - 1));
   const std::span<const std::uint8_t> bytes(message);
-  switch (data[0] % 4) {
+  switch (data[0] % 5) {
     case 0: {
       static DistilledGraph known, out;
       static bool init = false;
@@ -54,6 +57,27 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case 2: {
       auto q = DecodeRoomCloudRequest(bytes);
       if (q && (q->from == 0 || q->to == 0 || q->from == q->to)) std::abort();
+      break;
+    }
+    case 4: {
+      static FreeSpaceSummary summary;
+      static bool init = false;
+      if (!init) {
+        FreeSpaceSummaryConfig config;
+        config.max_cells = 1 << 16;
+        config.max_openings = 32;
+        if (!summary.Init(config)) std::abort();
+        init = true;
+      }
+      if (!DecodeFreeSpace(bytes, summary)) break;
+      if (summary.cells() > (1u << 16) || summary.openings().size() > 32) std::abort();
+      for (std::uint8_t c : summary.raw()) {
+        if (c > 2) std::abort();
+      }
+      for (const Opening& o : summary.openings()) {
+        if (!o.a.allFinite() || !o.b.allFinite()) std::abort();
+      }
+      if (!(summary.clearance_m(summary.origin_m()) >= 0.0f)) std::abort();
       break;
     }
     default: {

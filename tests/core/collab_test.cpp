@@ -194,7 +194,7 @@ TEST(RoomMessages, DescriptorsAndCloudsRoundTripCompactly) {
   std::vector<std::uint8_t> buffer(1 << 20);
   auto n = EncodeRoomDescriptor({2, 7, 4}, sc, buffer);
   ASSERT_TRUE(n);
-  EXPECT_EQ(*n, 21u + 20u * 60u + 4u);
+  EXPECT_EQ(*n, 22u + 20u * 60u + 4u);
   ScanContext back;
   auto h = DecodeRoomDescriptor(std::span(buffer.data(), *n), back);
   ASSERT_TRUE(h);
@@ -203,6 +203,20 @@ TEST(RoomMessages, DescriptorsAndCloudsRoundTripCompactly) {
     for (int s = 0; s < 60; ++s) EXPECT_NEAR(back.cell(r, s), sc.cell(r, s), 0.0051f);
   }
   EXPECT_LT(ScanContextDistance(sc, back)->distance, 0.01f);
+  // A 5 m high room: its heights go in 2 cm steps (5 m / 255 rounded up), within 1 cm.
+  const auto tall = test::BoxRoom(6, 4, 5.0, 3000, 0.01, 4, Eigen::Isometry3d(Eigen::Translation3d(-3, -2, 0)), false);
+  ASSERT_TRUE(sc.Build(tall, {20, 60, 12.0f, 0.0f}));
+  n = EncodeRoomDescriptor({2, 8, 1}, sc, buffer);
+  ASSERT_TRUE(n);
+  ASSERT_TRUE(DecodeRoomDescriptor(std::span(buffer.data(), *n), back));
+  float tallest = 0;
+  for (int r = 0; r < 20; ++r) {
+    for (int s = 0; s < 60; ++s) {
+      EXPECT_NEAR(back.cell(r, s), sc.cell(r, s), 0.0101f);
+      tallest = std::max(tallest, back.cell(r, s));
+    }
+  }
+  EXPECT_GT(tallest, 4.9f);
   // Clouds: float and 1 cm quantised (half the bytes, within 5 mm).
   BoundedVector<Eigen::Vector3f> points(4000);
   for (CloudEncoding e : {CloudEncoding::kFloat32, CloudEncoding::kQuantised16}) {

@@ -37,6 +37,7 @@
 #include <string>
 
 #include "evaluation.hpp"
+#include "explain.hpp"
 #include "lockstep_runner.hpp"
 #include "merge_tracker.hpp"
 #include "mission.hpp"
@@ -89,7 +90,8 @@ int main(int argc, char** argv) {
     tracker.AfterExchange(mission, mission_time_s);
   });
   const Evaluation evaluation = Evaluate(mission, tracker, o.evaluation);
-  const ReportInput report{o, mission, run, evaluation};
+  const std::vector<ViewExplanation> explanations = ExplainViews(mission, evaluation, o.explain_dir);
+  const ReportInput report{o, mission, run, evaluation, explanations};
 
   if (!o.out_dir.empty() && !WriteOutputs(o.out_dir, evaluation, run, error)) {
     std::fprintf(stderr, "collab: %s\n", error.c_str());

@@ -41,6 +41,8 @@ bool ParseOptions(int argc, char** argv, Options& o, std::string& error) {
       o.out_dir = v;
     } else if (a == "--summary") {
       o.summary_path = v;
+    } else if (a == "--explain") {
+      o.explain_dir = v;
     } else if (a == "--exchange-every-s") {
       if (!Number(v, o.every_s) || !(o.every_s > 0)) return fail(a + " takes seconds > 0");
     } else if (a == "--delay-s") {

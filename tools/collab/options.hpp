@@ -14,6 +14,7 @@ namespace msgraphs::tools::collab {
 
 struct Options {
   std::string run, out_dir, summary_path;
+  std::string explain_dir;  ///< --explain DIR: pictures of every view under the truth
   std::string mode_name = "rooms-walls-fine";
   std::string cloud_name = "q16";
   bool keyframes = false;  ///< --mode keyframes: the baseline
@@ -31,7 +32,8 @@ inline constexpr const char* kUsage =
     "                       [--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off]\n"
     "                       [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]...\n"
     "                       [--wrong-origin-m 0.5]\n"
-    "                       [--wrong-origin-deg 2] [--out DIR] [--summary FILE] [--markdown]\n";
+    "                       [--wrong-origin-deg 2] [--out DIR] [--summary FILE] [--explain DIR]\n"
+    "                       [--markdown]\n";
 
 /// False with `error` on a bad command line (the caller prints it and the usage, exit 2).
 bool ParseOptions(int argc, char** argv, Options& o, std::string& error);

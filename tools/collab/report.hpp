@@ -7,6 +7,7 @@
 #include <string>
 
 #include "evaluation.hpp"
+#include "explain.hpp"
 #include "lockstep_runner.hpp"
 #include "mission.hpp"
 #include "options.hpp"
@@ -18,6 +19,7 @@ struct ReportInput {
   const Mission& mission;
   const MissionRun& run;
   const Evaluation& evaluation;
+  const std::vector<ViewExplanation>& explanations;  ///< per view (room-based modes)
 };
 
 /// The text report.

@@ -81,11 +81,40 @@ void WriteRobots(JsonWriter& json, const ReportInput& in) {
   json.EndArray();
 }
 
-void WriteViews(JsonWriter& json, const Evaluation& ev) {
+void WriteExplanation(JsonWriter& json, const ViewExplanation* e) {
+  json.Key("explanation");
+  if (e == nullptr) {
+    json.Null();
+    return;
+  }
+  json.BeginObject();
+  json.Field("cause", e->cause);
+  json.Field("checked", e->checked);
+  json.Field("truth_proposed", e->proposed);
+  json.Field("truth_rank", e->rank);
+  json.Field("hypotheses", e->hypotheses);
+  json.Field("truth_agreement_m", e->truth.agreement.agreement_m);
+  json.Field("truth_constraint_m", e->truth.agreement.constraint_m);
+  json.Field("truth_conflict_m", e->truth.conflict_m());
+  json.Field("truth_walls_in_free_m", e->truth.conflict_b_in_a.walls_in_free_m + e->truth.conflict_a_in_b.walls_in_free_m);
+  json.Field("truth_openings_on_walls_m",
+             e->truth.conflict_b_in_a.openings_on_solid_m + e->truth.conflict_a_in_b.openings_on_solid_m);
+  json.Field("rule_verdict", core::ToString(e->decision.verdict));
+  json.Field("leader_truth_distance_m", e->leader_truth_distance_m);
+  json.Field("rival_agreement_m", e->decision.has_rival ? e->decision.rival.agreement.agreement_m : 0.0);
+  json.EndObject();
+}
+
+void WriteViews(JsonWriter& json, const Evaluation& ev, const std::vector<ViewExplanation>& explanations) {
   json.Key("views");
   json.BeginArray();
   for (const ViewEvaluation& v : ev.views) {
+    const ViewExplanation* e = nullptr;
+    for (const ViewExplanation& x : explanations) {
+      if (x.viewer == v.viewer && x.robot == v.robot) e = &x;
+    }
     json.BeginObject();
+    WriteExplanation(json, e);
     json.Field("viewer", v.viewer);
     json.Field("robot", v.robot);
     json.Field("merged", v.merged);
@@ -226,7 +255,7 @@ std::string JsonSummary(const ReportInput& in) {
   json.Field("mission_time_s", in.run.mission_time_s);
   json.Field("exchanges", in.run.exchanges.size());
   WriteRobots(json, in);
-  WriteViews(json, in.evaluation);
+  WriteViews(json, in.evaluation, in.explanations);
   WriteViewAte(json, in.evaluation);
   WriteMatchesAndData(json, in);
   json.EndObject();

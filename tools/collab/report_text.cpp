@@ -103,6 +103,21 @@ void ViewTable(const ReportInput& in, std::string& out) {
     if (v.merged && !v.origin.checked)
       Add(out, "    (origin not checked: %s)\n", v.origin.reason.c_str());
   }
+  for (const ViewExplanation& e : in.explanations) {
+    if (!e.checked) {
+      Add(out, "  why %d in %d: %s\n", e.robot, e.viewer, e.cause);
+      continue;
+    }
+    Add(out,
+        "  why %d in %d: %s; the truth: walls agree %.1f m (%.1f m weakest direction), conflict %.2f m "
+        "(walls in free %.2f + %.2f, openings on walls %.2f + %.2f), %s (rank %zu of %zu); the "
+        "rule now: %s, leader %.2f m from the truth; merged with %.2f m, solved %.2f m from it\n",
+        e.robot, e.viewer, e.cause, e.truth.agreement.agreement_m, e.truth.agreement.constraint_m,
+        e.truth.conflict_m(), e.truth.conflict_b_in_a.walls_in_free_m, e.truth.conflict_a_in_b.walls_in_free_m,
+        e.truth.conflict_b_in_a.openings_on_solid_m, e.truth.conflict_a_in_b.openings_on_solid_m,
+        e.proposed ? "proposed" : "NOT proposed", e.rank, e.hypotheses, core::ToString(e.decision.verdict),
+        e.leader_truth_distance_m, e.merge_truth_distance_m, e.solved_truth_distance_m);
+  }
   const ViewTotals t = ev.totals();
   Add(out, "views: %zu of %zu merged; %zu right, %zu wrong, %zu unchecked, %zu not merged\n",
       t.merged, t.views, t.right, t.wrong, t.unchecked, t.not_merged);

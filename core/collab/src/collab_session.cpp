@@ -80,7 +80,7 @@ Status CollabSessionConfig::Validate() const {
   if (auto s = free_space.Validate(); !s) return s;
   if (auto s = search.Validate(); !s) return s;
   if (auto s = merge.Validate(); !s) return s;
-  if (!(free_space_resend_share > 0 && free_space_resend_share <= 1) || !(wall_pair_min_overlap_m > 0) || max_log < 1) {
+  if (!(free_space_resend_share > 0 && free_space_resend_share <= 1) || !(wall_pair_min_overlap_m > 0) || !(floor_sigma_m > 0) || max_log < 1) {
     return Error{Errc::kInvalidConfig, "collab session: free-space share, pairing distances and log size"};
   }
   return graph.Validate();
@@ -131,7 +131,10 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
   m.config = config;
   m.floor_z_m = floor_z_map_m;
   if (auto s = m.distiller.Init(config.robot, graph_config, config.distiller); !s) return s;
-  if (auto s = m.builder.Init(config.descriptor); !s) return s;
+  // The builder thins a room's cloud to what the store holds: a hall is described, never refused.
+  RoomDescriptorConfig descriptor = config.descriptor;
+  descriptor.max_cloud_points = config.max_room_points;
+  if (auto s = m.builder.Init(descriptor); !s) return s;
   if (auto s = m.matcher.Init(config.matcher); !s) return s;
   if (auto s = m.graph.Init(config.graph, config.robot); !s) return s;
   m.stats = CollabSessionStats{};
@@ -504,6 +507,12 @@ bool CollabSession::merged(std::uint16_t robot) const {
 Eigen::Isometry3d CollabSession::T_self_robot(std::uint16_t robot) const {
   const Impl::Peer* p = impl_->FindPeer(robot);
   return p != nullptr && p->merged ? p->T_self_peer : Eigen::Isometry3d::Identity();
+}
+
+Eigen::Isometry3d CollabSession::T_self_robot_merge(std::uint16_t robot) const {
+  const Impl::Peer* p = impl_->FindPeer(robot);
+  return p != nullptr && p->merged ? p->T_merge.ToIsometry(impl_->floor_z_m - impl_->PeerFloor(*p))
+                                   : Eigen::Isometry3d::Identity();
 }
 
 const DistilledGraph* CollabSession::peer_graph(std::uint16_t robot) const {

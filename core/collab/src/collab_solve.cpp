@@ -43,6 +43,10 @@ void CollabSession::Impl::Solve() {
     const bool same = p.solved_version > 0 && e.translation().head<2>().norm() < config.anchored_translation_m &&
                       Eigen::AngleAxisd(e.linear()).angle() < config.anchored_rotation_rad;
     if (!graph.SetInitial(p.robot, same ? p.T_self_peer : T_merge)) continue;
+    // Both walk one floor (the merge placed them on it): the peer's floor centre at our floor.
+    const Eigen::Vector2d floor_xy = p.graph.has_floor ? p.graph.floor_centre : Eigen::Vector2d::Zero();
+    static_cast<void>(graph.AddSameFloor(p.robot, Eigen::Vector3d(floor_xy.x(), floor_xy.y(), PeerFloor(p)), floor_z_m,
+                                         config.floor_sigma_m));
     for (std::size_t k = 0; k < p.consistent_count; ++k) {
       const RoomMatch& m = p.matches[p.consistent[k]];
       if (m.fine_aligned &&

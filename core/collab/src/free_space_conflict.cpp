@@ -17,10 +17,34 @@ bool NearWall(const WallIndex& walls, const Eigen::Vector2d& p, double distance_
   return false;
 }
 
+// The sample at `p` of a wall running from `a` to `b` (y's frame) lies in a doorway of y's: y
+// mapped the same line on both sides of it, each piece overlapping the wall, the gap between
+// them no wider than a doorway. The wall is then the doorway's lintel, seen by one robot (a
+// VLP-16 sees a 4 m lintel only from 12 m away) and not the other. A wall that merely ends in
+// line with y's walls (a corridor's end wall between partitions aligned across the corridor)
+// does not span both pieces, and stays a conflict.
+bool InDoorwayOf(const WallIndex& walls, const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p,
+                 const Eigen::Vector2d& n, const FreeSpaceConflictConfig& c) {
+  const Eigen::Vector2d u = (b - a).normalized();
+  const double sa = std::min(u.dot(a), u.dot(b)), sb = std::max(u.dot(a), u.dot(b)), sp = u.dot(p);
+  double left_end = -1e300, right_start = 1e300;  // the nearest y pieces ending before p, starting after
+  for (const Eigen::Vector2d& m : {n, Eigen::Vector2d(-n)}) {
+    walls.ForEachNear(m, -m.dot(p), 0.17, c.door_wall_distance_m, [&](const AlignWall& w) {
+      const double s0 = std::min(u.dot(w.a), u.dot(w.b)), s1 = std::max(u.dot(w.a), u.dot(w.b));
+      const double overlap = std::min(s1, sb) - std::max(s0, sa);
+      if (overlap < c.extent_tolerance_m) return;
+      if (s1 <= sp) left_end = std::max(left_end, s1);
+      if (s0 >= sp) right_start = std::min(right_start, s0);
+    });
+  }
+  return right_start - left_end <= c.max_opening_m;
+}
+
 }  // namespace
 
 Status FreeSpaceConflictConfig::Validate() const {
   if (!(clearance_m > 0) || !(sample_step_m > 0.01 && sample_step_m <= 1.0) || !(opening_margin_m >= 0) ||
+      !(extent_tolerance_m >= 0) || !(max_opening_m >= 0) ||
       !(door_solid_share > 0 && door_solid_share <= 1) || !(door_wall_distance_m > 0)) {
     return Error{Errc::kInvalidConfig, "free-space conflict: distances and shares must be positive"};
   }
@@ -34,13 +58,19 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
   if (summary_y.empty()) return out;
   const double step = c.sample_step_m;
   for (const AlignWall& w : walls_x.walls()) {
-    const Eigen::Vector2d a = T_y_x * w.a, b = T_y_x * w.b;
-    const auto n = static_cast<int>(std::ceil(w.length_m / step));
+    const double inner = w.length_m - 2 * c.extent_tolerance_m;
+    if (inner <= 0) continue;
+    const Eigen::Vector2d dir = (w.b - w.a) / w.length_m;
+    const Eigen::Vector2d a = T_y_x * (w.a + c.extent_tolerance_m * dir);
+    const Eigen::Vector2d b = T_y_x * (w.b - c.extent_tolerance_m * dir);
+    const Eigen::Vector2d n_y = T_y_x.R() * w.n;
+    const auto n = static_cast<int>(std::ceil(inner / step));
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d p = a + (b - a) * ((i + 0.5) / n);
       if (static_cast<double>(summary_y.clearance_m(p)) < c.clearance_m) continue;
       if (summary_y.NearOpening(p, c.opening_margin_m)) continue;
-      out.walls_in_free_m += w.length_m / n;
+      if (InDoorwayOf(walls_y, a, b, p, n_y, c)) continue;
+      out.walls_in_free_m += inner / n;
     }
   }
   for (const Opening& o : summary_x.openings()) {

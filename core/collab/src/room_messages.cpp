@@ -12,7 +12,11 @@ namespace msgraphs::core {
 namespace {
 
 constexpr std::uint8_t kFormat = 1;
-constexpr std::size_t kDescriptorHeader = 4 + 1 + 2 + 4 + 4 + 1 + 1 + 4;  // 21
+// Descriptors: format 2 adds the height step (cm per unit: rooms up to 2.55 m at 1 cm, taller
+// ones coarser); format 1 (1 cm, 21-byte header) is still read.
+constexpr std::uint8_t kDescriptorFormat = 2;
+constexpr std::size_t kDescriptorHeaderV1 = 4 + 1 + 2 + 4 + 4 + 1 + 1 + 4;  // 21
+constexpr std::size_t kDescriptorHeader = kDescriptorHeaderV1 + 1;         // 22
 constexpr std::size_t kCloudHeader = 4 + 1 + 1 + 2 + 4 + 4 + 4 + 4;       // 24
 
 void PutF32(std::uint8_t* p, float f) {
@@ -57,18 +61,25 @@ Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& h,
     return Error{Errc::kCapacityExceeded, "room descriptor: output buffer too small"};
   std::uint8_t* p = out.data();
   std::memcpy(p, "MSRD", 4);
-  p[4] = kFormat;
+  p[4] = kDescriptorFormat;
   WriteU16Le(p + 5, h.robot);
   WriteU32Le(p + 7, h.room);
   WriteU32Le(p + 11, h.version);
   p[15] = static_cast<std::uint8_t>(d.rings());
   p[16] = static_cast<std::uint8_t>(d.sectors());
   PutF32(p + 17, d.max_radius_m());
+  // The finest whole-centimetre step at which the tallest cell fits 255 units (20 m at most).
+  float tallest = 0;
+  for (int r = 0; r < d.rings(); ++r)
+    for (int s = 0; s < d.sectors(); ++s) tallest = std::max(tallest, d.cell(r, s));
+  const int step_cm = std::clamp(static_cast<int>(std::ceil(tallest * 100.0f / 255.0f)), 1, 8);
+  p[21] = static_cast<std::uint8_t>(step_cm);
+  const float step_m = 0.01f * static_cast<float>(step_cm);
   std::size_t at = kDescriptorHeader;
   for (int r = 0; r < d.rings(); ++r) {
     for (int s = 0; s < d.sectors(); ++s, ++at) {
-      const float cm = std::round(std::clamp(d.cell(r, s), 0.0f, 2.55f) * 100.0f);
-      p[at] = static_cast<std::uint8_t>(cm);
+      const float units = std::round(std::clamp(d.cell(r, s), 0.0f, 255.0f * step_m) / step_m);
+      p[at] = static_cast<std::uint8_t>(units);
     }
   }
   WriteU32Le(p + at, Crc32(out.first(at)));
@@ -77,9 +88,14 @@ Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& h,
 
 Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t> bytes,
                                                     ScanContext& d) {
-  if (auto s = CheckCrc(bytes, kDescriptorHeader); !s) return s.error();
+  if (auto s = CheckCrc(bytes, kDescriptorHeaderV1); !s) return s.error();
   if (!MagicIs(bytes, "MSRD")) return Error{Errc::kMalformed, "room descriptor: bad magic"};
-  if (bytes[4] != kFormat) return Error{Errc::kUnsupported, "room descriptor: unknown format"};
+  if (bytes[4] != 1 && bytes[4] != kDescriptorFormat)
+    return Error{Errc::kUnsupported, "room descriptor: unknown format"};
+  const std::size_t header = bytes[4] == 1 ? kDescriptorHeaderV1 : kDescriptorHeader;
+  if (bytes.size() < header + 4) return Error{Errc::kMalformed, "room descriptor: shorter than its header"};
+  const int step_cm = bytes[4] == 1 ? 1 : bytes[21];
+  if (step_cm < 1 || step_cm > 8) return Error{Errc::kMalformed, "room descriptor: height step out of range"};
   RoomDescriptorHeader h;
   h.robot = ReadU16Le(&bytes[5]);
   h.room = ReadU32Le(&bytes[7]);
@@ -90,12 +106,12 @@ Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t
       sectors > ScanContext::kMaxSectors) {
     return Error{Errc::kMalformed, "room descriptor: rings or sectors out of range"};
   }
-  if (bytes.size() != kDescriptorHeader + static_cast<std::size_t>(rings * sectors) + 4) {
+  if (bytes.size() != header + static_cast<std::size_t>(rings * sectors) + 4) {
     return Error{Errc::kMalformed, "room descriptor: length does not match rings x sectors"};
   }
   std::array<float, ScanContext::kMaxRings * ScanContext::kMaxSectors> cells{};
   for (std::size_t i = 0; i < static_cast<std::size_t>(rings * sectors); ++i) {
-    cells[i] = static_cast<float>(bytes[kDescriptorHeader + i]) * 0.01f;
+    cells[i] = static_cast<float>(bytes[header + i]) * 0.01f * static_cast<float>(step_cm);
   }
   if (auto s = d.FromCells(
           rings, sectors, radius,

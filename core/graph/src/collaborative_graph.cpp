@@ -97,6 +97,20 @@ struct OriginMeasured {
   }
 };
 
+// Two robots walk the same floor: robot b's floor point, through its origin, is at self's
+// floor height. Vertical walls say nothing of heights, and their normals' slight tilts would
+// otherwise let the origin's height wander.
+struct SameFloor {
+  Eigen::Vector3d p_b;  // a point on robot b's floor, its map frame
+  double z_self, inv_sigma;
+  template <typename T>
+  bool operator()(const T* q, const T* t, T* r) const {
+    const Eigen::Matrix<T, 3, 1> p = Rotation(q) * p_b.cast<T>() + Eigen::Matrix<T, 3, 1>(t[0], t[1], t[2]);
+    r[0] = (p[2] - T(z_self)) * T(inv_sigma);
+    return true;
+  }
+};
+
 }  // namespace
 
 Status CollaborativeGraphConfig::Validate() const {
@@ -371,6 +385,24 @@ Status CollaborativeGraph::AddOriginMeasurement(std::uint16_t robot_b,
           new OriginMeasured{Eigen::Quaterniond(T.linear()).normalized(), T.translation(),
                              1.0 / sigma_m, 1.0 / sigma_rad}),
       m.huber.get(), o->q, o->t);
+  ++o->factors;
+  ++m.factors;
+  return Ok();
+}
+
+Status CollaborativeGraph::AddSameFloor(std::uint16_t robot_b, const Eigen::Vector3d& floor_point_b,
+                                        double floor_z_self, double sigma_m) {
+  Impl& m = *impl_;
+  Impl::Origin* o = m.Get(robot_b);
+  if (o == nullptr || robot_b == m.self)
+    return Error{Errc::kNotFound, "collaborative graph: robot without an initial origin"};
+  if (!floor_point_b.allFinite() || !std::isfinite(floor_z_self) || !(sigma_m > 0))
+    return Error{Errc::kInvalidArgument, "collaborative graph: floor not finite or sigma not positive"};
+  if (auto s = m.HasRoomForFactor(); !s) return s;
+  m.Use(robot_b);
+  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<SameFloor, 1, 4, 3>(
+                                  new SameFloor{floor_point_b, floor_z_self, 1.0 / sigma_m}),
+                              m.huber.get(), o->q, o->t);
   ++o->factors;
   ++m.factors;
   return Ok();

@@ -114,6 +114,9 @@ struct CollabSessionConfig {
   /// With fewer than two room matches the merge agrees with, the walls the merge lays on each
   /// other along at least this tie the maps (wall-to-wall factors).
   double wall_pair_min_overlap_m = 1.0;
+  /// How well two robots' floors agree in height (each is its robot's base height below its
+  /// first pose: Spot's body height varies by a few centimetres with its gait).
+  double floor_sigma_m = 0.03;
   std::size_t max_log = 512;  ///< merge decisions kept (the oldest give way, counted)
   CollaborativeGraphConfig graph;
   Status Validate() const;
@@ -229,6 +232,9 @@ class CollabSession {
   bool merged(std::uint16_t robot) const;
   /// Robot `robot`'s map frame in this robot's map frame (identity for this robot).
   Eigen::Isometry3d T_self_robot(std::uint16_t robot) const;
+  /// The transform the merge decision placed `robot` with (before the collaborative graph refines
+  /// it); identity when not merged.
+  Eigen::Isometry3d T_self_robot_merge(std::uint16_t robot) const;
   /// The peer's distilled graph as received (nullptr for unknown robots).
   const DistilledGraph* peer_graph(std::uint16_t robot) const;
   /// Accepted matches with `robot` (the consistent set), into `out`; returns how many.

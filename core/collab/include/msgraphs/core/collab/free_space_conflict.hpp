@@ -2,8 +2,11 @@
 // Negative evidence for a transform between two maps: what one robot mapped, laid into the
 // other's frame, where the other robot saw something else.
 // - A wall in seen-through space: samples of robot x's walls that fall at least `clearance_m`
-//   inside robot y's free space (FreeSpaceSummary::clearance_m), except across y's openings (a
-//   wall over a doorway is its lintel).
+//   inside robot y's free space (FreeSpaceSummary::clearance_m), except across y's openings and
+//   in the doorways between two pieces of one of y's walls that x's wall spans (a wall over a
+//   doorway is its lintel, seen by one robot and not the other), and within `extent_tolerance_m` of the wall's ends (an
+//   extent grows with every point associated to the plane and overshoots now and then; a wrong
+//   transform lays whole walls across free space, not their last half metre).
 // - An opening on a solid wall: samples of x's openings that fall on cells y saw occupied next
 //   to one of y's walls, away from y's own openings; counted when they cover at least
 //   `door_solid_share` of the opening (a correct transform leaves the jambs, a fraction of it).
@@ -25,10 +28,12 @@ struct FreeSpaceConflictConfig {
   /// centimetres.
   double clearance_m = 0.3;
   double sample_step_m = 0.1;
+  double extent_tolerance_m = 0.5;
   /// An opening this close is the same opening; a wall sample this close to one is its lintel.
   double opening_margin_m = 0.3;
   double door_solid_share = 0.6;
   double door_wall_distance_m = 0.3;  ///< an occupied cell this close to a wall line is that wall
+  double max_opening_m = 3.0;         ///< the widest doorway (building codes: double doors 2.4 m)
   Status Validate() const;
 };
 

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Room descriptors and room clouds on the wire (little-endian, CRC-32 at the end).
 //
-// Descriptor: "MSRD" | format u8 | robot u16 | room u32 | version u32 | rings u8 | sectors u8 |
-//   max radius f32 | cells u8 x rings x sectors (heights in cm, 0-2.55 m: a room cloud is cropped
-//   at 2.4 m above the floor) -> 1.2 kB for 20 x 60 instead of 4.8 kB of f32.
+// Descriptor: "MSRD" | format u8 (2) | robot u16 | room u32 | version u32 | rings u8 | sectors u8
+//   | max radius f32 | height step u8 (cm) | cells u8 x rings x sectors (heights in steps: 1 cm
+//   up to 2.55 m, the step growing with the room's tallest cell, up to 8 cm) -> 1.2 kB for
+//   20 x 60 instead of 4.8 kB of f32. Format 1 (no step byte, 1 cm) is still decoded.
 // Cloud: "MSRC" | format u8 | encoding u8 | robot u16 | room u32 | version u32 | step f32 |
 //   points u32 | points as f32 x3 (encoding 0), as i16 x3 in units of `step` (encoding 1: 6
 //   bytes a point, +-327 m at 1 cm) or as i8 x3 in units of `step` (encoding 2: 3 bytes a point,

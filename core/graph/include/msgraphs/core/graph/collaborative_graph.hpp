@@ -71,6 +71,11 @@ class CollaborativeGraph {
                               double sigma_m,
                               double sigma_rad);
 
+  /// Robot b walks self's floor: `floor_point_b` (on b's floor, b's map frame) lies at height
+  /// `floor_z_self` in self's frame.
+  Status AddSameFloor(std::uint16_t robot_b, const Eigen::Vector3d& floor_point_b, double floor_z_self,
+                      double sigma_m);
+
   /// Solves; returns the final cost. A failed or non-finite solve restores the previous values.
   Expected<double> Solve();
 
