@@ -151,25 +151,41 @@ std::vector<std::pair<double, double>> CutStrip(
 std::vector<std::pair<double, double>> CutIdentical(
     const Strip& s, double width_m, double end_min_m, int& first, int& count) {
   const double frontage = s.f1 - s.f0;
-  int n = static_cast<int>(std::floor(frontage / width_m));
-  double rest = frontage - n * width_m;
-  // End rooms on both sides: each takes half the rest (and whatever lies beyond the frontage).
-  // (each end room also needs enough corridor in front of it for a door).
-  while (n >= 2 && (0.5 * rest < kEndFrontage_m ||
-                    0.5 * rest + std::min(s.f0 - s.a0(), s.a1() - s.f1) < end_min_m)) {
-    --n;
-    rest += width_m;
-  }
-  if (n < 2) return {};
-  const double start = SnapCm(s.f0 + 0.5 * rest);
+  const bool lo_end = s.f0 - s.a0() > 1e-6,
+             hi_end = s.a1() - s.f1 > 1e-6;  // strip beyond the corridor
   std::vector<std::pair<double, double>> out;
-  out.emplace_back(s.a0(), start);
-  for (int k = 0; k < n; ++k)
-    out.emplace_back(SnapCm(start + k * width_m), SnapCm(start + (k + 1) * width_m));
-  out.emplace_back(out.back().second, s.a1());
-  first = 1;
-  count = n;
-  return out;
+  for (int n = static_cast<int>(std::floor(frontage / width_m)); n >= 2; --n) {
+    const double rest = frontage - n * width_m;
+    if (!lo_end && !hi_end) {
+      // The row fills the strip: the rooms stretch to share the rest (all still identical).
+      const double w = frontage / n;
+      for (int k = 0; k < n; ++k) {
+        out.emplace_back(k == 0 ? s.a0() : out.back().second,
+                         k + 1 == n ? s.a1() : s.a0() + (k + 1) * w);
+      }
+      first = 0;
+      count = n;
+      return out;
+    }
+    // An end room on each side that has strip beyond the corridor takes the rest there (and
+    // needs enough corridor in front of it for a door).
+    const int ends = (lo_end ? 1 : 0) + (hi_end ? 1 : 0);
+    const double share = rest / ends;
+    const double lo_len = s.f0 - s.a0() + share, hi_len = s.a1() - s.f1 + share;
+    if (share < kEndFrontage_m || (lo_end && lo_len < end_min_m) || (hi_end && hi_len < end_min_m))
+      continue;
+    const double start = lo_end ? SnapCm(s.f0 + share) : s.a0();
+    if (lo_end) out.emplace_back(s.a0(), start);
+    first = static_cast<int>(out.size());
+    for (int k = 0; k < n; ++k) {
+      const double end = k + 1 == n && !hi_end ? s.a1() : SnapCm(start + (k + 1) * width_m);
+      out.emplace_back(k == 0 ? start : out.back().second, end);
+    }
+    if (hi_end) out.emplace_back(out.back().second, s.a1());
+    count = n;
+    return out;
+  }
+  return {};
 }
 
 int PlanBuilder::Room(RoomUse use, const std::vector<Rect>& rects) {

@@ -176,9 +176,26 @@ RoomWalk WalkRoom(const ClearanceGrid& grid,
   }
   std::vector<char> reached(in_room.size(), 0);
   std::deque<std::pair<int, int>> queue;
+  // A mouth stands for the roomiest cell within 0.15 m of it (the estimate's own error is of
+  // that order).
+  auto mouth_cell = [&](const Vec2& p, int& bi, int& bj) {
+    double best = -1;
+    for (double dy = -0.15; dy <= 0.151; dy += 0.05) {
+      for (double dx = -0.15; dx <= 0.151; dx += 0.05) {
+        int i = 0, j = 0;
+        if (!grid.CellOf(p + Vec2(dx, dy), i, j) || !in_room[index(i, j)]) continue;
+        if (grid.Clearance(i, j) > best) {
+          best = grid.Clearance(i, j);
+          bi = i;
+          bj = j;
+        }
+      }
+    }
+    return best >= pass_m;
+  };
   auto seed = [&](const Vec2& p) {
     int i = 0, j = 0;
-    if (!grid.CellOf(p, i, j) || grid.Clearance(i, j) < pass_m) return false;
+    if (!mouth_cell(p, i, j)) return false;
     if (!reached[index(i, j)]) {
       reached[index(i, j)] = 1;
       queue.emplace_back(i, j);
@@ -227,7 +244,7 @@ RoomWalk WalkRoom(const ClearanceGrid& grid,
   walk.mouths_connected = ok;
   for (std::size_t m = 1; m < mouths.size() && walk.mouths_connected; ++m) {
     int i = 0, j = 0;
-    walk.mouths_connected = grid.CellOf(mouths[m], i, j) && reached[index(i, j)] != 0;
+    walk.mouths_connected = mouth_cell(mouths[m], i, j) && reached[index(i, j)] != 0;
   }
   walk.no_pockets = ok;
   for (int j = 0; j < ny; ++j) {

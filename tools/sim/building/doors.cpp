@@ -12,6 +12,10 @@ constexpr double kEndMargin_m = 0.1;  // solid wall kept at a wall's own ends
 constexpr double kDoorGap_m = 0.3;    // solid wall kept between two doors of one wall
 constexpr double kMinDoor_m = 0.8;    // narrowest door placed
 constexpr double kLintel_m = 0.2;     // thinnest lintel above a door
+// A narrow door keeps this much more solid wall beside it (a door frame's return), so that a
+// robot coming through has room to turn even next to a corner.
+constexpr double kNarrowDoor_m = 1.2;
+constexpr double kJambReturn_m = 0.25;
 
 bool IsCirculation(RoomUse u) {
   return u == RoomUse::kCorridor || u == RoomUse::kLobby || u == RoomUse::kHallway;
@@ -164,10 +168,12 @@ bool DoorPlacer::Place(const Connection& c, int index) {
   // The longest free stretch of wall the two rooms share.
   int best_wall = -1;
   std::pair<double, double> best{0, 0};
+  const double jamb = c.width_m < kNarrowDoor_m ? kJambReturn_m : 0.0;
   for (std::size_t w = 0; w < walls_.size(); ++w) {
     for (const WallSpan& s : walls_[w].spans) {
       if (!((s.left == c.a && s.right == b) || (s.left == b && s.right == c.a))) continue;
-      for (const auto& f : FreeIntervals(static_cast<int>(w), s.s0_m, s.s1_m)) {
+      for (auto f : FreeIntervals(static_cast<int>(w), s.s0_m, s.s1_m)) {
+        f = {f.first + jamb, f.second - jamb};
         if (f.second - f.first > best.second - best.first + 1e-9) {
           best = f;
           best_wall = static_cast<int>(w);
@@ -193,8 +199,9 @@ bool DoorPlacer::PlaceAt(const Connection& c, int b, const Vec2& centre, int ind
         continue;
       if (s < span.s0_m || s > span.s1_m) continue;
       const double lo = s - 0.5 * c.width_m, hi = s + 0.5 * c.width_m;
+      const double jamb = c.width_m < kNarrowDoor_m ? kJambReturn_m : 0.0;
       for (const auto& f : FreeIntervals(static_cast<int>(w), span.s0_m, span.s1_m)) {
-        if (lo >= f.first - 1e-9 && hi <= f.second + 1e-9) {
+        if (lo >= f.first + jamb - 1e-9 && hi <= f.second - jamb + 1e-9) {
           Add(static_cast<int>(w), c.a, b, lo, c.width_m, DoorHeight(c), index);
           return true;
         }

@@ -109,6 +109,7 @@ std::string WriteFeatures(const BuildingFeatures& f) {
   }
   for (const auto& [a, b] : f.mirror_pairs) line("mirror", a + " " + b);
   line("attempts", std::to_string(f.attempts));
+  for (const auto& why : f.rejected) line("rejected", why);
   return out;
 }
 

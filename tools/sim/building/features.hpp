@@ -33,7 +33,8 @@ struct BuildingFeatures {
   std::vector<std::vector<std::string>> identical_groups;
   /// (room, its mirror image) across the building's axis.
   std::vector<std::pair<std::string, std::string>> mirror_pairs;
-  int attempts = 1;  ///< layouts drawn until one passed every check
+  int attempts = 1;                   ///< layouts drawn until one passed every check
+  std::vector<std::string> rejected;  ///< why each earlier layout was drawn again
 };
 
 /// Fills the counts and sizes that follow from the world itself.

@@ -12,7 +12,7 @@ namespace {
 
 constexpr std::uint64_t kFurnishStream = 0x6675726E;  // "furn"
 constexpr double kCell_m = 0.1;
-constexpr double kMouthDepth_m = 0.45;  // past the wall's face
+constexpr double kMouthDepth_m = 0.5;  // past the wall's face
 
 struct RoomDoors {
   std::vector<DoorZone> zones;

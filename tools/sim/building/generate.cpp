@@ -164,14 +164,23 @@ World GenerateBuilding(std::uint64_t seed,
                        BuildingFeatures* features) {
   const Choices base = Resolve(seed, options);
   World world;
+  std::vector<std::string> rejected;  // why earlier attempts were drawn again
   for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
     Choices c = base;
     c.scale = std::pow(kShrinkPerAttempt, attempt);
     Random rng = Random::Stream(seed, kLayoutStream, static_cast<std::uint64_t>(attempt));
     Plan plan;
     std::string error;
-    if (!BuildStyle(c, rng, plan, error) || plan.broken) continue;
-    if (static_cast<int>(plan.rooms.size()) > kMaxRooms || plan.rooms.empty()) continue;
+    auto reject = [&](const std::string& why) { rejected.push_back(why); };
+    if (!BuildStyle(c, rng, plan, error) || plan.broken) {
+      reject("layout: " +
+             (error.empty() ? std::string("a room is not one simple polygon") : error));
+      continue;
+    }
+    if (static_cast<int>(plan.rooms.size()) > kMaxRooms || plan.rooms.empty()) {
+      reject(std::to_string(plan.rooms.size()) + " rooms");
+      continue;
+    }
     Vec2 lo(1e18, 1e18), hi(-1e18, -1e18);
     for (const PlanRoom& r : plan.rooms) {
       for (const Vec2& p : r.polygon) {
@@ -179,12 +188,25 @@ World GenerateBuilding(std::uint64_t seed,
         hi = hi.cwiseMax(p);
       }
     }
-    if ((hi - lo).maxCoeff() > kMaxFootprint_m || RoomsOverlap(plan)) continue;
+    if ((hi - lo).maxCoeff() > kMaxFootprint_m) {
+      reject("footprint " + std::to_string(static_cast<int>((hi - lo).maxCoeff())) + " m");
+      continue;
+    }
+    if (RoomsOverlap(plan)) {
+      reject("wings overlap");
+      continue;
+    }
     std::vector<PlanWall> walls;
-    if (!BuildWalls(plan, walls, error)) continue;
+    if (!BuildWalls(plan, walls, error)) {
+      reject("walls: " + error);
+      continue;
+    }
     DoorPlacer placer(plan, walls);
     placer.PlaceAll();
-    if (!placer.ConnectAll(error)) continue;
+    if (!placer.ConnectAll(error)) {
+      reject("doors: " + error);
+      continue;
+    }
     for (int c_index : placer.displaced())
       Uncopy(plan, plan.connections[static_cast<std::size_t>(c_index)].a);
     for (int c_index : placer.failed()) {
@@ -195,7 +217,11 @@ World GenerateBuilding(std::uint64_t seed,
     // A copy whose original lost its copy status keeps its own geometry but not the claim.
     FurnishReport report;
     const auto room_items = Furnish(plan, walls, placer.doors(), Amount(c.clutter), seed, report);
-    if (!report.unwalkable_rooms.empty()) continue;
+    if (!report.unwalkable_rooms.empty()) {
+      const PlanRoom& r = plan.rooms[static_cast<std::size_t>(report.unwalkable_rooms.front())];
+      reject(std::string("unwalkable ") + ToString(r.use));
+      continue;
+    }
     KeepVerifiedCopies(plan, placer.doors(), room_items);
     std::vector<Item> items;
     for (const auto& list : room_items) items.insert(items.end(), list.begin(), list.end());
@@ -205,7 +231,10 @@ World GenerateBuilding(std::uint64_t seed,
                              plan.name + "), seed " + std::to_string(seed);
     world = ToWorld(plan, walls, items, c.rotation_deg, centre, name);
     ParseError parse_error;
-    if (!ParseWorld(WriteWorld(world), parse_error)) continue;
+    if (!ParseWorld(WriteWorld(world), parse_error)) {
+      reject("invalid world: " + parse_error.reason);
+      continue;
+    }
 
     if (features != nullptr) {
       BuildingFeatures& f = *features;
@@ -232,22 +261,47 @@ World GenerateBuilding(std::uint64_t seed,
                    : mirror       ? Symmetry::kMirroredWings
                                   : Symmetry::kNone;
       f.attempts = attempt + 1;
+      f.rejected = rejected;
       MeasureWorld(world, f);
     }
     return world;
   }
-  // Every attempt failed (no seed in the tested ranges does this): the plainest building.
+  // Every attempt failed (no seed in seeds 1..300 gets here): the plainest building, and
+  // failing that two rooms and a door.
   BuildingOptions plain;
   plain.style = Style::kOffice;
   plain.corridor = CorridorShape::kStraight;
   plain.symmetry = Symmetry::kNone;
   plain.clutter = Clutter::kNone;
   plain.rotation_deg = options.rotation_deg;
-  if (options.style == plain.style && options.corridor == plain.corridor &&
-      options.clutter == plain.clutter) {
-    return world;  // already the plainest: give up with what the last attempt made
+  if (!(options.style == plain.style && options.corridor == plain.corridor &&
+        options.clutter == plain.clutter && options.symmetry == plain.symmetry)) {
+    return GenerateBuilding(seed, plain, features);
   }
-  return GenerateBuilding(seed, plain, features);
+  world = World{};
+  world.name = "Generated fallback building (two rooms), seed " + std::to_string(seed);
+  world.levels.push_back({0, 0.0, 3.0});
+  auto wall = [&](const char* id, double x1, double y1, double x2, double y2, double t) {
+    world.walls.push_back({id, {x1, y1}, {x2, y2}, t, 3.0, 0, Material::kPainted, {}});
+  };
+  wall("e1", -6, -3, 6, -3, 0.3);
+  wall("e2", 6, -3, 6, 3, 0.3);
+  wall("e3", 6, 3, -6, 3, 0.3);
+  wall("e4", -6, 3, -6, -3, 0.3);
+  wall("i1", 0, -3, 0, 3, 0.12);
+  world.walls.back().doors.push_back({2.5, 1.0, 2.1});
+  world.rooms.push_back({"R1", "office", 0, {{-6, -3}, {0, -3}, {0, 3}, {-6, 3}}});
+  world.rooms.push_back({"R2", "office", 0, {{0, -3}, {6, -3}, {6, 3}, {0, 3}}});
+  if (features != nullptr) {
+    *features = BuildingFeatures{};
+    features->seed = seed;
+    features->attempts = 2 * kMaxAttempts;
+    features->rejected = rejected;
+    features->footprint_width_m = 6;
+    features->footprint_length_m = 12;
+    MeasureWorld(world, *features);
+  }
+  return world;
 }
 
 }  // namespace msgraphs::sim::building

@@ -93,16 +93,16 @@ bool RoomLayout::Fits(const Item& item, double gap_m) const {
   for (const Vec2& c : corners) {
     if (!Inside(room_, c)) return false;
   }
-  // Clear of every wall's face (the back of a wall item touches it, hence the tolerance).
+  // Clear of every wall's face (the back of a wall item touches it, hence the tolerance), and
+  // no reflex corner of the room poking into the footprint.
+  const auto past_face = Corners(item, face_ - 1e-6);
   for (std::size_t i = 0; i < room_.size(); ++i) {
     const Vec2& a = room_[i];
     const Vec2& b = room_[(i + 1) % room_.size()];
     for (const Vec2& c : corners) {
       if (SegmentDistance(c, a, b) < face_ - 1e-6) return false;
     }
-    // A reflex corner of the room poking into the footprint.
-    const auto grown = Corners(item, face_ - 1e-6);
-    if (Inside(grown, a)) return false;
+    if (Inside(past_face, a)) return false;
   }
   for (const DoorZone& z : doors_) {
     if (Overlap(Corners(item), ZoneCorners(z))) return false;

@@ -86,8 +86,10 @@ Unit DrawUnit(Random& rng, double width, double depth, double f_lo, double f_hi)
       const double p = rng.Uniform();
       use = p < 0.45 ? RoomUse::kBath : p < 0.8 ? RoomUse::kWc : RoomUse::kStorage;
     }
-    u.rooms.push_back({{Rect{SnapCm(x), 0, SnapCm(x + front[i]), df}}, use});
-    x += front[i];
+    // The last piece ends exactly at the flat's side (its width need not be on the cm grid).
+    const double x1 = i + 1 == front.size() ? width : SnapCm(x + front[i]);
+    u.rooms.push_back({{Rect{x, 0, x1, df}}, use});
+    x = x1;
   }
   // Back: a living room and bedrooms.
   const int back_rooms = width < 6.6 ? 1 : width < 9.6 ? 2 : 3;
@@ -167,18 +169,18 @@ bool BuildApartment(const Choices& c, Random& rng, Plan& plan, std::string& erro
   auto len = [&](double lo, double hi) { return SnapCm(std::max(lo, rng.Uniform(lo, hi) * k)); };
   switch (c.corridor) {
     case CorridorShape::kL:
-      spec.length_m = len(depth + 7, 22);
-      spec.arm_m = len(depth + 7, 18);
+      spec.length_m = len(depth + 7, 20);
+      spec.arm_m = len(depth + 7, 16);
       break;
     case CorridorShape::kT:
-      spec.length_m = len(2 * depth + spec.width_m + 14, 34);
+      spec.length_m = len(2 * depth + spec.width_m + 14, 32);
       spec.branch_at_m = SnapCm(rng.Uniform(depth + 7, spec.length_m - spec.width_m - depth - 7));
       spec.arm_m = len(depth + 7, 14);
       break;
     default:
       spec.shape = CorridorShape::kStraight;
       plan.corridor = CorridorShape::kStraight;
-      spec.length_m = len(14, 34);
+      spec.length_m = len(12, 28);
   }
   const CorridorLayout layout = LayoutCorridors(spec);
   PlanBuilder b(plan, Affine2());

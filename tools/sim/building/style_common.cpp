@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "style_common.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -147,10 +148,18 @@ Joint JoinWings(Plan& plan, const Wing& a, const Wing& b, double angle_rad, Rand
         builder.Connect(b.west_corridor, a.east_corridor, DrawDoor(rng, DoorKind::kOpening, 0.5));
     return joint;
   }
-  // The wedge between the wings, from the pivot to the far side of the corridors, is a lobby.
+  // The wedge between the wings is a lobby: from the pivot to 1.5 m past the far side of the
+  // corridors (into the end rooms there), so that the corridors open well inside it.
   const double L = a.length_m, w = a.corridor_w;
-  const Polygon lobby = angle_rad > 0 ? Polygon{a.T({L, 0}), b.T({0, 0}), a.T({L, a.y_hi})}
-                                      : Polygon{a.T({L, w}), a.T({L, a.y_lo}), b.T({0, w})};
+  constexpr double kPast_m = 1.5;
+  Polygon lobby;
+  if (angle_rad > 0) {
+    const double ea = std::min(kPast_m, -a.y_lo), eb = std::min(kPast_m, -b.y_lo);
+    lobby = {a.T({L, -ea}), b.T({0, -eb}), a.T({L, a.y_hi})};
+  } else {
+    const double ea = std::min(kPast_m, a.y_hi - w), eb = std::min(kPast_m, b.y_hi - b.corridor_w);
+    lobby = {a.T({L, w + ea}), a.T({L, a.y_lo}), b.T({0, b.corridor_w + eb})};
+  }
   joint.lobby = builder.RoomPolygon(RoomUse::kLobby, lobby);
   joint.door_into_a =
       builder.Connect(joint.lobby, a.east_corridor, DrawDoor(rng, DoorKind::kOpening, 0.5));

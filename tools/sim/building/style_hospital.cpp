@@ -42,15 +42,15 @@ bool BuildHospital(const Choices& c, Random& rng, Plan& plan, std::string& error
   auto len = [&](double lo, double hi) { return SnapCm(std::max(lo, rng.Uniform(lo, hi) * k)); };
   if (c.mirrored_wings()) {
     CorridorSpec hub = spec;
-    hub.length_m = len(10, 18);
-    BuildWingedPlan(c, rng, plan, hub, spec, 12, 20, recipe, identical);
+    hub.length_m = len(8, 14);
+    BuildWingedPlan(c, rng, plan, hub, spec, 10, 16, recipe, identical);
     return true;
   }
   spec.shape = c.corridor;
   switch (c.corridor) {
     case CorridorShape::kNone:
     case CorridorShape::kStraight:
-      spec.length_m = len(20, 44);
+      spec.length_m = len(16, 36);
       break;
     case CorridorShape::kL:
       spec.length_m = len(spec.depth_w_m + 6, 28);

@@ -27,7 +27,7 @@ bool BuildMultiWing(const Choices& c, Random& rng, Plan& plan, std::string& erro
   CorridorSpec hub = spec;
   hub.length_m = SnapCm(std::max(12.0, rng.Uniform(14, 26) * c.scale));
   const double identical = c.identical_rows() ? Pick(rng, kRow) : 0.0;
-  BuildWingedPlan(c, rng, plan, hub, spec, 12, 24, recipe, identical);
+  BuildWingedPlan(c, rng, plan, hub, spec, 10, 20, recipe, identical);
   (void)error;
   return true;
 }

@@ -35,11 +35,11 @@ void SizeCorridors(
       s.arm_m = len(s.depth_n_m + 7, 26);
       break;
     case CorridorShape::kU:
-      s.length_m = len(2 * w + 2 * s.depth_in_m + 6, 48);
-      s.arm_m = len(s.depth_n_m + 7, 24);
+      s.length_m = len(2 * w + 2 * s.depth_in_m + 6, 40);
+      s.arm_m = len(s.depth_n_m + 7, 20);
       break;
     case CorridorShape::kLoop:
-      s.length_m = len(22, 46);
+      s.length_m = len(22, 40);
       s.arm_m = SnapCm(2 * w + rng.Uniform(8.5, 15.0));
       break;
   }
@@ -82,7 +82,7 @@ bool BuildOffice(const Choices& c, Random& rng, Plan& plan, std::string& error) 
   if (c.mirrored_wings()) {
     CorridorSpec hub = spec;
     hub.length_m = SnapCm(std::max(12.0, rng.Uniform(14, 28) * c.scale));
-    BuildWingedPlan(c, rng, plan, hub, spec, 14, 28, recipe, identical);
+    BuildWingedPlan(c, rng, plan, hub, spec, 12, 24, recipe, identical);
     return true;
   }
   const CorridorLayout layout = LayoutCorridors(spec);

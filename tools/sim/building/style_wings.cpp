@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Hubs with wings: mirrored pairs or chains of straight wings turned at their joints.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -19,11 +20,16 @@ void BuildWingedPlan(const Choices& c,
   static constexpr double kAngles[] = {30.0, 45.0, 60.0, 90.0};
   plan.corridor = CorridorShape::kStraight;
   auto draw_angle = [&]() { return c.wing_angle_forced ? c.wing_angle_deg : Pick(rng, kAngles); };
-  PlanBuilder hub_builder(plan, Affine2::Translation({-0.5 * hub_spec.length_m, 0}));
-  const Wing hub = AddStraightWing(hub_builder, hub_spec, recipe, rng, identical_width_m);
+  // With identical rows, every block is long enough for at least two of them per strip.
+  const double row_m = identical_width_m > 0 ? SnapCm(2 * identical_width_m + 1.0) : 0.0;
+  CorridorSpec hub_block = hub_spec;
+  hub_block.length_m = std::max(hub_spec.length_m, row_m);
+  PlanBuilder hub_builder(plan, Affine2::Translation({-0.5 * hub_block.length_m, 0}));
+  const Wing hub = AddStraightWing(hub_builder, hub_block, recipe, rng, identical_width_m);
   auto add_wing = [&](const Wing& from, double angle_deg) {
     CorridorSpec s = wing_spec;
-    s.length_m = SnapCm(std::max(8.0, rng.Uniform(wing_length_lo_m, wing_length_hi_m) * c.scale));
+    s.length_m =
+        SnapCm(std::max({8.0, row_m, rng.Uniform(wing_length_lo_m, wing_length_hi_m) * c.scale}));
     s.split = false;
     const double y_lo = -s.depth_s_m, y_hi = s.width_m + s.depth_n_m;
     PlanBuilder b(plan, AttachEast(from, y_lo, y_hi, angle_deg * std::numbers::pi / 180.0));
