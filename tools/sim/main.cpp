@@ -70,7 +70,15 @@ int main(int argc, char** argv) {
     else if (a == "--seed") mission_config.seed = std::strtoull(need(), nullptr, 10);
     else if (a == "--threads") threads = std::max(1, std::atoi(need()));
     else if (a == "--shared-rooms") mission_config.shared_rooms = std::atoi(need());
-    else if (a == "--building") building_seed = std::strtoull(need(), nullptr, 10);
+    else if (a == "--building") {
+      const char* text = need();
+      char* end = nullptr;
+      building_seed = std::strtoull(text, &end, 10);
+      if (end == text || *end != '\0') {
+        std::fprintf(stderr, "msgraphs_sim: --building needs a seed (a whole number), not '%s'\n", text);
+        return 2;
+      }
+    }
     else if (a == "--world-out") world_out = need();
     else if (msgraphs::sim::building::IsOption(a)) {
       if (!msgraphs::sim::building::SetOption(a, need(), building_options, error)) {
@@ -82,7 +90,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (world_path.empty() == !building_seed.has_value() ||
+  if (world_path.empty() == !building_seed.has_value() || (!world_out.empty() && !building_seed) ||
       (out_dir.empty() && !validate_only && svg_path.empty() && world_out.empty())) {
     Usage();
     return 2;
