@@ -128,6 +128,27 @@ TEST(Scene, RaysHitWallsFloorCeilingColumnsAndPassDoors) {
   EXPECT_NEAR(scene.DistanceToSurface({3.0, 3.0, 0.1}), 0.1, 1e-9);
 }
 
+// An opening up to the ceiling (door height = wall height, no lintel) is a valid door, and the
+// scene leaves it open from floor to ceiling.
+TEST(WorldFormat, ADoorAsHighAsItsWallIsAnOpeningWithoutLintel) {
+  std::string text = kTwoRooms;
+  text.replace(text.find("door mid 2.5 1.0 2.0"), 20, "door mid 2.5 1.0 3.0");
+  const World w = Parse(text);
+  ASSERT_EQ(w.walls[4].doors.size(), 1u);
+  EXPECT_EQ(w.walls[4].doors[0].height_m, w.walls[4].height_m);
+  const Scene scene(w, 0);
+  auto scratch = scene.MakeScratch();
+  // At 2.9 m (where a lintel would be) the ray passes the doorway to the east wall at x = 9.9.
+  const auto hit = scene.Cast({4.0, 2.9, 2.9}, {1, 0, 0}, 100, scratch);
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_NEAR(hit->range_m, 5.9, 1e-9);
+  // Taller than the wall is still refused.
+  ParseError error;
+  text.replace(text.find("door mid 2.5 1.0 3.0"), 20, "door mid 2.5 1.0 3.1");
+  EXPECT_FALSE(ParseWorld(text, error).has_value());
+  EXPECT_NE(error.reason.find("door height"), std::string::npos);
+}
+
 TEST(Scene, ARotatedWallIsHitWhereGeometrySaysSo) {
   // A single wall along the 30-degree diagonal; a ray along its normal from 2 m away.
   const double a = 30.0 * std::numbers::pi / 180.0;

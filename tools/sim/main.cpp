@@ -4,13 +4,17 @@
 //
 //   msgraphs_sim --world tools/sim/worlds/office.world --out runs/office --robots 3 --duration-s 300 --seed 1
 //   msgraphs_sim --world my.world --validate          # check a world file and stop
+//   msgraphs_sim --building 7 --out runs/b7           # a generated building (building/generate.hpp)
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
+
+#include "building/generate.hpp"
 
 #include "lidar_sim.hpp"
 #include "mission.hpp"
@@ -18,6 +22,7 @@
 #include "scene.hpp"
 #include "truth.hpp"
 #include "world.hpp"
+#include "world_writer.hpp"
 
 namespace {
 
@@ -25,15 +30,22 @@ using namespace msgraphs::sim;
 
 void Usage() {
   std::fprintf(stderr,
-               "usage: msgraphs_sim --world FILE (--out DIR | --validate | --svg FILE)\n"
+               "usage: msgraphs_sim (--world FILE | --building SEED [building options]) (--out DIR | --validate | --svg FILE)\n"
                "                    [--robots N (2..10, default 3)] [--duration-s S (default 300)] [--seed N]\n"
-               "                    [--threads N] [--pcap-ns] [--svg FILE] [--shared-rooms N (default 2)]\n");
+               "                    [--threads N] [--pcap-ns] [--svg FILE] [--shared-rooms N (default 2)]\n"
+               "       msgraphs_sim --building SEED [building options] --world-out FILE [--svg FILE]\n"
+               "building options: --style office|hospital|warehouse|construction|apartment|multi-wing\n"
+               "                  --corridor straight|L|T|U|loop  --symmetry none|identical-row|mirrored-wings|both\n"
+               "                  --clutter none|sparse|medium|dense  --rotation-deg D  --wing-angle-deg 0|30|45|60|90\n"
+               "                  --ceiling-m H (2.3..6)\n");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string world_path, out_dir, svg_path;
+  std::string world_path, out_dir, svg_path, world_out, error;
+  std::optional<std::uint64_t> building_seed;
+  msgraphs::sim::building::BuildingOptions building_options;
   bool validate_only = false, pcap_ns = false;
   MissionConfig mission_config;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -58,17 +70,54 @@ int main(int argc, char** argv) {
     else if (a == "--seed") mission_config.seed = std::strtoull(need(), nullptr, 10);
     else if (a == "--threads") threads = std::max(1, std::atoi(need()));
     else if (a == "--shared-rooms") mission_config.shared_rooms = std::atoi(need());
-    else {
+    else if (a == "--building") {
+      const char* text = need();
+      char* end = nullptr;
+      building_seed = std::strtoull(text, &end, 10);
+      if (end == text || *end != '\0') {
+        std::fprintf(stderr, "msgraphs_sim: --building needs a seed (a whole number), not '%s'\n", text);
+        return 2;
+      }
+    }
+    else if (a == "--world-out") world_out = need();
+    else if (msgraphs::sim::building::IsOption(a)) {
+      if (!msgraphs::sim::building::SetOption(a, need(), building_options, error)) {
+        std::fprintf(stderr, "msgraphs_sim: %s\n", error.c_str());
+        return 2;
+      }
+    } else {
       Usage();
       return 2;
     }
   }
-  if (world_path.empty() || (out_dir.empty() && !validate_only && svg_path.empty())) {
+  if (world_path.empty() == !building_seed.has_value() || (!world_out.empty() && !building_seed) ||
+      (out_dir.empty() && !validate_only && svg_path.empty() && world_out.empty())) {
     Usage();
     return 2;
   }
-  std::string error;
-  auto world = LoadWorld(world_path, error);
+  std::optional<World> world;
+  std::string building_text;  // the generated building's feature summary
+  if (building_seed) {
+    if (const std::string e = msgraphs::sim::building::CheckOptions(building_options); !e.empty()) {
+      std::fprintf(stderr, "msgraphs_sim: %s\n", e.c_str());
+      return 2;
+    }
+    msgraphs::sim::building::BuildingFeatures features;
+    world = msgraphs::sim::building::GenerateBuilding(*building_seed, building_options, &features);
+    building_text = msgraphs::sim::building::WriteFeatures(features);
+    world_path = "building " + std::to_string(*building_seed);
+    if (!world_out.empty()) {
+      const std::string summary = std::filesystem::path(world_out).replace_extension(".building.txt").string();
+      if (!SaveWorld(*world, world_out) || !(std::ofstream(summary) << building_text) ||
+          (!svg_path.empty() && out_dir.empty() && !WriteSvg(*world, nullptr, 0, svg_path))) {
+        std::fprintf(stderr, "msgraphs_sim: cannot write %s\n", world_out.c_str());
+        return 1;
+      }
+      if (out_dir.empty()) return 0;
+    }
+  } else {
+    world = LoadWorld(world_path, error);
+  }
   if (!world) {
     std::fprintf(stderr, "msgraphs_sim: %s\n", error.c_str());
     return 1;
@@ -98,7 +147,12 @@ int main(int argc, char** argv) {
 
   namespace fs = std::filesystem;
   fs::create_directories(fs::path(out_dir) / "truth");
-  fs::copy_file(world_path, fs::path(out_dir) / "world.world", fs::copy_options::overwrite_existing);
+  if (building_seed) {
+    SaveWorld(*world, (fs::path(out_dir) / "world.world").string());
+    std::ofstream(fs::path(out_dir) / "building.txt") << building_text;
+  } else {
+    fs::copy_file(world_path, fs::path(out_dir) / "world.world", fs::copy_options::overwrite_existing);
+  }
   WriteWallsCsv(*world, (fs::path(out_dir) / "truth" / "walls.csv").string());
   WriteRoomsCsv(*world, (fs::path(out_dir) / "truth" / "rooms.csv").string());
   WriteSvg(*world, &*mission, mission_config.level, (fs::path(out_dir) / "map.svg").string());
