@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The local S-Graph front end: odometry buffer, keyframe cloud store, plane association, the
 // Hessian-shaped information, and the whole mapper on a synthetic room walked with biased
-// odometry; bad input counted; no allocation on the per-scan path.
+// odometry, also for laps on end with a keyframe store a third of the walk (loops everywhere);
+// bad input counted; no allocation on the per-scan path.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "alloc_counter.hpp"
@@ -158,9 +160,9 @@ std::vector<Eigen::Vector3f> ScanAt(const Eigen::Isometry3d& T_world_base,
 // The true path (base at 0.5 m) inside the room and odometry with 5 % scale error and yaw drift.
 struct Walk {
   std::vector<Eigen::Isometry3d> truth, odometry;
-  Walk() {
+  explicit Walk(int steps = 30) {  // 15 a lap
     Eigen::Isometry3d odo = Eigen::Isometry3d::Identity();
-    for (int i = 0; i < 30; ++i) {
+    for (int i = 0; i < steps; ++i) {
       const double a = 2 * std::numbers::pi * i / 15.0;
       Eigen::Isometry3d T =
           Pose(5 + 2.5 * std::cos(a), 4 + 2.0 * std::sin(a), a + std::numbers::pi / 2);
@@ -258,7 +260,8 @@ TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
   }
   const SGraph& g = mapper.graph();
   const std::uint32_t last = static_cast<std::uint32_t>(g.keyframe_slots() - 1);
-  const Eigen::Isometry3d T_map_odom = g.keyframe_pose(last) * mapper.keyframe_odometry(last).inverse();
+  const Eigen::Isometry3d T_map_odom =
+      g.keyframe_pose(last) * mapper.keyframe_odometry(last).inverse();
   // Where the node stopped, and where it would be had it kept its last step's motion three
   // more steps, times 1.5 (the caller's prediction over the downtime).
   RelocaliseSearch search;
@@ -295,6 +298,58 @@ TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
   ASSERT_TRUE(empty.Init(config));
   EXPECT_EQ(empty.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search).error().code,
             Errc::kNotFound);
+}
+
+// Four laps of the room with a keyframe store for a third of them: loop closures every few
+// keyframes once the path is 10 m long, so that soon every keyframe the graph could sparsify
+// carries one. The first version then wrote the next keyframe past the graph's and the mapper's
+// per-keyframe arrays.
+TEST(LocalMapper, PatrolWithLoopsEverywhereStaysWithinTheGraphsCapacity) {
+  LocalMapperConfig config = SmallConfig(20, 256);
+  config.graph.local_window_keyframes = 8;
+  LocalMapper mapper;
+  ASSERT_TRUE(mapper.Init(config));
+  const Walk walk(60);
+  std::vector<float> times(20000, 0.1f);
+  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
+    const double t = 10.0 + static_cast<double>(i);
+    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
+    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
+    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
+    auto outcome = mapper.AddScan({points, times, t - 0.1, t});
+    ASSERT_TRUE(outcome) << "keyframe " << i << ": " << outcome.error().detail;
+    ASSERT_EQ(*outcome, ScanOutcome::kKeyframe);
+    ASSERT_LE(mapper.graph().keyframe_slots(), config.graph.max_keyframes + 1);
+    ASSERT_LE(mapper.graph().stats().keyframes, config.graph.max_keyframes);
+  }
+  ASSERT_TRUE(mapper.Finish());
+  const SGraph& g = mapper.graph();
+  const SGraphStats s = g.stats();
+  EXPECT_EQ(s.keyframes, config.graph.max_keyframes);
+  EXPECT_EQ(s.sparsified, walk.truth.size() - config.graph.max_keyframes);
+  EXPECT_EQ(s.rejected_keyframes, 0u);
+  EXPECT_EQ(s.sparsify_dropped, 0u);
+  EXPECT_EQ(mapper.stats().keyframes_refused, 0u);
+  EXPECT_EQ(mapper.stats().chain_factors_refused, 0u);
+  EXPECT_GE(mapper.stats().loop_closures, 5u);
+  EXPECT_GT(s.sparsified_with_loops, 0u);
+  EXPECT_GT(s.sparsify_carried, 0u);
+  // The survivors are where they belong; the odometry alone is far off by the last lap.
+  double worst = 0, worst_odometry = 0;
+  for (std::uint32_t k = 0; k < g.keyframe_slots(); ++k) {
+    if (!g.keyframe_active(k)) continue;
+    const auto i = static_cast<std::size_t>(g.keyframe_stamp(k) - 10.0 + 0.5);
+    worst =
+        std::max(worst, (g.keyframe_pose(k).translation() - walk.truth[i].translation()).norm());
+    worst_odometry = std::max(
+        worst_odometry, (walk.odometry[i].translation() - walk.truth[i].translation()).norm());
+  }
+  EXPECT_GT(worst_odometry, 0.5);
+  EXPECT_LT(worst, 0.05);
+  std::printf(
+      "loops %llu, loop victims %zu, carried %zu, merged %zu; worst %.3f m (odometry %.3f)\n",
+      static_cast<unsigned long long>(mapper.stats().loop_closures), s.sparsified_with_loops,
+      s.sparsify_carried, s.sparsify_merged, worst, worst_odometry);
 }
 
 TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {

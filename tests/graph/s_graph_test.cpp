@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The local S-Graph back end on synthetic graphs with known truth: odometry drift removed by
-// walls, rooms and corridors placed by their walls, the gauge, sparsification within capacity,
-// and every kind of bad input refused and counted with the graph left finite.
+// walls, rooms and corridors placed by their walls, the gauge, and every kind of bad input refused
+// and counted with the graph left finite. Sparsification: s_graph_sparsify_test.cpp.
 #include "msgraphs/core/graph/s_graph.hpp"
 
 #include <gtest/gtest.h>
@@ -13,112 +13,12 @@
 #include <vector>
 
 #include "msgraphs/core/geometry/se3.hpp"
+#include "s_graph_fixtures.hpp"
 
 namespace msgraphs::core {
 namespace {
 
-struct TruePlane {
-  Eigen::Vector3d n;
-  double d;
-};
-
-// A rectangular room (size_x x size_y, rotated by yaw about its centre), walls facing inwards,
-// and its floor 0.5 m below the base frame.
-struct Room {
-  Eigen::Vector2d centre{3.0, -2.0};
-  double yaw = 0.5;
-  double size_x = 8.0, size_y = 6.0;
-  std::vector<TruePlane> walls() const {
-    std::vector<TruePlane> out;
-    const Eigen::Matrix3d R = RotZ(yaw);
-    const Eigen::Vector3d c(centre.x(), centre.y(), 0);
-    const Eigen::Vector3d ex = R.col(0), ey = R.col(1);
-    // Low x (faces +x), high x (faces -x), low y, high y.
-    for (auto [n, half] :
-         {std::pair{ex, size_x / 2}, std::pair{Eigen::Vector3d(-ex), size_x / 2},
-          std::pair{ey, size_y / 2}, std::pair{Eigen::Vector3d(-ey), size_y / 2}}) {
-      const Eigen::Vector3d on_wall = c - n * half;
-      out.push_back({n, -n.dot(on_wall)});
-    }
-    return out;
-  }
-};
-
-PlaneMeasurement Measure(const TruePlane& p,
-                         const Eigen::Isometry3d& T,
-                         std::mt19937& rng,
-                         double sigma) {
-  std::normal_distribution<double> noise(0.0, sigma);
-  PlaneMeasurement z;
-  z.normal = (T.linear().transpose() * p.n + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)))
-                 .normalized();
-  z.d = p.d + p.n.dot(T.translation()) + noise(rng);
-  z.basis_u = z.normal.unitOrthogonal();
-  z.basis_v = z.normal.cross(z.basis_u);
-  z.covariance = Eigen::Matrix3d::Identity() * sigma * sigma;
-  return z;
-}
-
-Matrix6d OdometryInformation() {
-  Matrix6d info = Matrix6d::Zero();
-  info.diagonal() << 1 / (0.03 * 0.03), 1 / (0.03 * 0.03), 1 / (0.03 * 0.03), 1 / (0.005 * 0.005),
-      1 / (0.005 * 0.005), 1 / (0.005 * 0.005);
-  return info;
-}
-
-// A robot walking laps of an ellipse inside the room, with drifting odometry (scale +3 %,
-// yaw +0.17 degrees per step: about Spot's 1 degree per 10 m, exaggerated threefold).
-struct Walk {
-  std::vector<Eigen::Isometry3d> truth, odometry;
-  explicit Walk(const Room& room, int steps) {
-    Eigen::Isometry3d odo = Eigen::Isometry3d::Identity();
-    for (int i = 0; i < steps; ++i) {
-      const double a = 2 * std::numbers::pi * i / 24.0;
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      T.linear() = RotZ(room.yaw + a + std::numbers::pi / 2);
-      T.translation() = Eigen::Vector3d(room.centre.x(), room.centre.y(), 0) +
-                        RotZ(room.yaw) * Eigen::Vector3d(2.5 * std::cos(a), 1.8 * std::sin(a), 0);
-      if (i > 0) {
-        Eigen::Isometry3d delta = truth.back().inverse() * T;
-        delta.translation() *= 1.03;
-        delta.linear() = RotZ(0.003) * delta.linear();
-        odo = odo * delta;
-      } else {
-        odo = T;
-      }
-      truth.push_back(T);
-      odometry.push_back(odo);
-    }
-  }
-};
-
-// Keyframe i of the walk, guessed from the previous estimate and the odometry, joined to the
-// previous keyframe by the odometry factor; its id goes to the back of `ids`.
-void AddWalkStep(SGraph& g, const Walk& walk, std::size_t i, std::vector<std::uint32_t>& ids) {
-  const Eigen::Isometry3d guess =
-      i == 0 ? walk.truth[0]
-             : g.keyframe_pose(ids.back()) * (walk.odometry[i - 1].inverse() * walk.odometry[i]);
-  auto id = g.AddKeyframe(static_cast<double>(i), guess);
-  ASSERT_TRUE(id);
-  if (i > 0) {
-    ASSERT_TRUE(g.AddRelativePose(ids.back(), *id,
-                                  walk.odometry[i - 1].inverse() * walk.odometry[i],
-                                  OdometryInformation(), RelativePoseKind::kOdometry));
-  }
-  ids.push_back(*id);
-}
-
-double MaxPositionError(const SGraph& g,
-                        const std::vector<std::uint32_t>& ids,
-                        const std::vector<Eigen::Isometry3d>& truth) {
-  double worst = 0;
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (!g.keyframe_active(ids[i])) continue;
-    worst =
-        std::max(worst, (g.keyframe_pose(ids[i]).translation() - truth[i].translation()).norm());
-  }
-  return worst;
-}
+using namespace sgraph_test;  // NOLINT(google-build-using-namespace): test fixtures
 
 TEST(SGraph, WallsRemoveOdometryDriftAndTheOriginStays) {
   const Room room;
@@ -420,61 +320,6 @@ TEST(SGraph, SolveAtItsIterationLimitIsReportedAndUsable) {
   EXPECT_TRUE(report->usable);
   EXPECT_EQ(g.stats().solves_not_converged, 1u);
   EXPECT_EQ(g.stats().solves_undone, 0u);
-}
-
-TEST(SGraph, SparsificationKeepsTheGraphWithinCapacity) {
-  SGraphConfig config;
-  config.max_keyframes = 12;
-  config.local_window_keyframes = 4;
-  SGraph g;
-  ASSERT_TRUE(g.Init(config));
-  const Room room;
-  const Walk walk(room, 60);
-  auto walls = room.walls();
-  walls.push_back({Eigen::Vector3d::UnitZ(), 0.5});  // the floor holds z, roll and pitch
-  std::mt19937 rng(5);
-  std::vector<std::uint32_t> plane_ids;
-  std::uint32_t prev = 0;
-  std::vector<std::uint32_t> ids;
-  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
-    const Eigen::Isometry3d guess =
-        i == 0 ? walk.truth[0]
-               : g.keyframe_pose(prev) * (walk.odometry[i - 1].inverse() * walk.odometry[i]);
-    const std::uint32_t k = *g.AddKeyframe(static_cast<double>(i), guess);
-    if (i == 0) {
-      for (const TruePlane& w : walls) {
-        plane_ids.push_back(
-            *g.AddPlane(w.n, w.d, w.n.z() > 0.5 ? PlaneClass::kFloor : PlaneClass::kWall));
-      }
-    } else {
-      ASSERT_TRUE(g.AddRelativePose(prev, k, walk.odometry[i - 1].inverse() * walk.odometry[i],
-                                    OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-    for (std::size_t w = 0; w < walls.size(); ++w) {
-      ASSERT_TRUE(
-          g.AddPlaneObservation(k, plane_ids[w], Measure(walls[w], walk.truth[i], rng, 0.005)));
-    }
-    ASSERT_TRUE(g.Solve(SolveKind::kLocal));
-    EXPECT_LE(g.stats().keyframes, config.max_keyframes);
-    prev = k;
-  }
-  const SGraphStats s = g.stats();
-  EXPECT_EQ(s.keyframes, config.max_keyframes);
-  EXPECT_EQ(s.keyframes_peak, config.max_keyframes);
-  EXPECT_EQ(s.sparsified, walk.truth.size() - config.max_keyframes);
-  EXPECT_GT(s.relative_factors[static_cast<std::size_t>(RelativePoseKind::kSparsified)], 0u);
-  EXPECT_TRUE(g.keyframe_active(0));  // the origin is never sparsified
-  ASSERT_TRUE(g.Solve(SolveKind::kFull));
-  // The survivors are still where they belong.
-  std::array<std::uint32_t, 12> recent{};
-  const std::size_t n = g.RecentKeyframes(recent);
-  EXPECT_EQ(n, config.max_keyframes);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double stamp = g.keyframe_stamp(recent[i]);
-    const auto& truth = walk.truth[static_cast<std::size_t>(stamp)];
-    EXPECT_LT((g.keyframe_pose(recent[i]).translation() - truth.translation()).norm(), 0.05)
-        << "keyframe at " << stamp;
-  }
 }
 
 TEST(SGraph, ConfigIsValidated) {

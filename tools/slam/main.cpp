@@ -345,6 +345,14 @@ int main(int argc, char** argv) {
       gs.relative_factors[3], gs.plane_factors, gs.room_factors, gs.wall_wall_factors,
       gs.floor_factors);
   std::printf(
+      "sparsification: %zu of them carrying loops, %zu loops carried to a neighbour (%zu fused "
+      "with one there), %zu constraints dropped; keyframes refused %llu (mapper %llu), odometry "
+      "or scan-matching factors refused %llu\n",
+      gs.sparsified_with_loops, gs.sparsify_carried, gs.sparsify_merged, gs.sparsify_dropped,
+      static_cast<unsigned long long>(gs.rejected_keyframes),
+      static_cast<unsigned long long>(ms.keyframes_refused),
+      static_cast<unsigned long long>(ms.chain_factors_refused));
+  std::printf(
       "refused: pose %llu, stamp %llu, information %llu, behind %llu, missing node %llu, capacity "
       "%llu; solves %llu "
       "(%llu at their limit, %llu undone)\n",

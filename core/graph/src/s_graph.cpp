@@ -1,92 +1,21 @@
 // SPDX-License-Identifier: MIT
+// The S-Graph's public API; its state and shared helpers are in s_graph_impl.hpp, and
+// sparsification in s_graph_sparsify.cpp.
 #include "msgraphs/core/graph/s_graph.hpp"
 
 #include <ceres/ceres.h>
-#include <ceres/sphere_manifold.h>
 
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <vector>
 
+#include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/graph/distilled_graph.hpp"
 #include "s_graph_factors.hpp"
+#include "s_graph_impl.hpp"
 
 namespace msgraphs::core {
-namespace {
-
-constexpr std::int32_t kNone = -1;
-
-enum class FactorKind : std::uint8_t {
-  kRelative,
-  kPlane,
-  kRoom,
-  kWallWall,
-  kFloorRoom,
-  kPlanePrior
-};
-
-struct KeyframeNode {
-  double q[4] = {0, 0, 0, 1};  // Eigen order: x y z w
-  double t[3] = {0, 0, 0};
-  double stamp_s = 0;
-  std::int32_t prev = kNone, next = kNone;  // neighbours in time among active keyframes
-  std::uint32_t loop_factors = 0;
-  // Every relative-pose measurement from `prev` to this keyframe fused into one (information-
-  // weighted in the tangent space) with the summed information: what a composed factor is
-  // made of when a keyframe between them is sparsified. Measurements, not estimates: an
-  // estimate taken before the next full solve would bake its error into the graph.
-  Eigen::Isometry3d measurement_from_prev = Eigen::Isometry3d::Identity();
-  Matrix6d information_from_prev = Matrix6d::Zero();
-  bool active = false;
-};
-
-struct PlaneNode {
-  double n[3] = {1, 0, 0};
-  double d[1] = {0};
-  MapPlane info;
-  bool in_problem = false;
-};
-
-struct RoomNode {
-  double c[2] = {0, 0};
-  MapRoom info;
-  std::int32_t factor = kNone;
-  std::int32_t floor_factor = kNone;
-  bool in_problem = false;
-};
-
-struct FactorRecord {
-  FactorKind kind = FactorKind::kRelative;
-  RelativePoseKind relative = RelativePoseKind::kOdometry;
-  std::uint32_t a = 0, b = 0;  // keyframes, keyframe and plane, planes, room, floor and room
-  ceres::ResidualBlockId id = nullptr;
-  bool active = false;
-};
-
-bool SqrtInformation6(const Matrix6d& information, Matrix6d& sqrt_information) {
-  if (!information.allFinite() || !information.isApprox(information.transpose(), 1e-6))
-    return false;
-  Eigen::LLT<Matrix6d> llt(information);
-  if (llt.info() != Eigen::Success) return false;
-  sqrt_information = llt.matrixU();
-  return sqrt_information.allFinite();
-}
-
-// Adjoint of T for tangent vectors ordered [translation; rotation].
-Matrix6d Adjoint(const Eigen::Isometry3d& T) {
-  Matrix6d A = Matrix6d::Zero();
-  const Eigen::Matrix3d R = T.linear();
-  const Eigen::Vector3d t = T.translation();
-  Eigen::Matrix3d tx;
-  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
-  A.topLeftCorner<3, 3>() = R;
-  A.topRightCorner<3, 3>() = tx * R;
-  A.bottomRightCorner<3, 3>() = R;
-  return A;
-}
-
-}  // namespace
 
 Status SGraphConfig::Validate() const {
   if (max_keyframes < 8 || max_planes < 1 || max_rooms < 1 || max_factors < 16) {
@@ -109,281 +38,6 @@ Status SGraphConfig::Validate() const {
   }
   return Ok();
 }
-
-struct SGraph::Impl {
-  SGraphConfig config;
-  std::unique_ptr<ceres::Problem> problem;
-  ceres::EigenQuaternionManifold quaternion_manifold;
-  ceres::SphereManifold<3> sphere_manifold;
-  std::unique_ptr<ceres::LossFunction> huber_relative, huber_loop, huber_plane, huber_room;
-
-  std::vector<KeyframeNode> keyframes;
-  std::vector<std::int32_t> free_keyframe_slots;
-  std::size_t keyframe_high_water = 0;  // slots ever used
-  std::int32_t newest = kNone, origin = kNone;
-  std::size_t active_keyframes = 0;
-
-  std::vector<PlaneNode> planes;
-  std::size_t plane_count = 0;
-  std::vector<RoomNode> rooms;
-  std::size_t room_count = 0;
-  double floor_c[2] = {0, 0};
-  bool floor_active = false;
-
-  std::vector<FactorRecord> factors;
-  std::vector<std::int32_t> free_factor_slots;
-  std::size_t factor_high_water = 0, active_factors = 0;
-
-  std::vector<double> snapshot;  // parameter values before a solve, to undo a bad one
-  SGraphStats stats;
-
-  bool ValidKeyframe(std::uint32_t id) const {
-    return id < keyframe_high_water && keyframes[id].active;
-  }
-  bool ValidPlane(std::uint32_t id) const { return id < plane_count && planes[id].info.active; }
-  bool ValidRoom(std::uint32_t id) const { return id < room_count && rooms[id].info.active; }
-
-  Eigen::Isometry3d Pose(std::uint32_t id) const {
-    const KeyframeNode& k = keyframes[id];
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(k.q[3], k.q[0], k.q[1], k.q[2]).normalized().toRotationMatrix();
-    T.translation() = Eigen::Vector3d(k.t[0], k.t[1], k.t[2]);
-    return T;
-  }
-
-  Expected<std::int32_t> NewFactor(FactorKind kind, std::uint32_t a, std::uint32_t b) {
-    std::int32_t slot = kNone;
-    if (!free_factor_slots.empty()) {
-      slot = free_factor_slots.back();
-      free_factor_slots.pop_back();
-    } else if (factor_high_water < factors.size()) {
-      slot = static_cast<std::int32_t>(factor_high_water++);
-    } else {
-      ++stats.rejected_capacity;
-      return Error{Errc::kCapacityExceeded, "s-graph factor store full"};
-    }
-    FactorRecord& f = factors[static_cast<std::size_t>(slot)];
-    f = FactorRecord{};
-    f.kind = kind;
-    f.a = a;
-    f.b = b;
-    f.active = true;
-    ++active_factors;
-    stats.factors_peak = std::max(stats.factors_peak, active_factors);
-    return slot;
-  }
-
-  // Forgets a factor record (the residual block is removed by the caller or by Ceres).
-  void DropFactor(std::int32_t slot) {
-    FactorRecord& f = factors[static_cast<std::size_t>(slot)];
-    if (!f.active) return;
-    f.active = false;
-    --active_factors;
-    switch (f.kind) {
-      case FactorKind::kRelative:
-        --stats.relative_factors[static_cast<std::size_t>(f.relative)];
-        if (f.relative == RelativePoseKind::kLoopClosure) {
-          if (keyframes[f.a].loop_factors > 0) --keyframes[f.a].loop_factors;
-          if (keyframes[f.b].loop_factors > 0) --keyframes[f.b].loop_factors;
-        }
-        break;
-      case FactorKind::kPlane:
-        --stats.plane_factors;
-        break;
-      case FactorKind::kRoom:
-        --stats.room_factors;
-        break;
-      case FactorKind::kWallWall:
-        --stats.wall_wall_factors;
-        break;
-      case FactorKind::kFloorRoom:
-        --stats.floor_factors;
-        break;
-      case FactorKind::kPlanePrior:
-        --stats.plane_prior_factors;
-        break;
-    }
-    free_factor_slots.push_back(slot);  // capacity reserved at Init: no allocation
-  }
-
-  void RemoveFactor(std::int32_t slot) {
-    FactorRecord& f = factors[static_cast<std::size_t>(slot)];
-    if (!f.active) return;
-    problem->RemoveResidualBlock(f.id);
-    DropFactor(slot);
-  }
-
-  void EnsurePlaneInProblem(PlaneNode& p) {
-    if (p.in_problem) return;
-    problem->AddParameterBlock(p.n, 3, &sphere_manifold);
-    problem->AddParameterBlock(p.d, 1);
-    p.in_problem = true;
-  }
-
-  Expected<std::uint32_t> AddRelative(std::uint32_t from,
-                                      std::uint32_t to,
-                                      const Eigen::Isometry3d& T_from_to,
-                                      const Matrix6d& information,
-                                      RelativePoseKind kind) {
-    if (!ValidKeyframe(from) || !ValidKeyframe(to) || from == to) {
-      ++stats.rejected_missing_node;
-      return Error{Errc::kNotFound, "relative pose between missing keyframes"};
-    }
-    if (!IsValidRigidTransform(T_from_to, 1e-6)) {
-      ++stats.rejected_pose;
-      return Error{Errc::kInvalidArgument, "relative pose is not a finite rigid transform"};
-    }
-    Matrix6d sqrt_information;
-    if (!SqrtInformation6(information, sqrt_information)) {
-      ++stats.rejected_information;
-      return Error{Errc::kInvalidArgument,
-                   "relative pose information is not symmetric positive definite"};
-    }
-    auto slot = NewFactor(FactorKind::kRelative, from, to);
-    if (!slot) return slot.error();
-    auto* functor =
-        new sgraph::RelativePoseResidual{Eigen::Quaterniond(T_from_to.linear()).normalized(),
-                                         T_from_to.translation(), sqrt_information};
-    auto* cost =
-        new ceres::AutoDiffCostFunction<sgraph::RelativePoseResidual, 6, 4, 3, 4, 3>(functor);
-    ceres::LossFunction* loss =
-        kind == RelativePoseKind::kLoopClosure ? huber_loop.get() : huber_relative.get();
-    FactorRecord& f = factors[static_cast<std::size_t>(*slot)];
-    f.relative = kind;
-    f.id = problem->AddResidualBlock(cost, loss, keyframes[from].q, keyframes[from].t,
-                                     keyframes[to].q, keyframes[to].t);
-    ++stats.relative_factors[static_cast<std::size_t>(kind)];
-    if (kind == RelativePoseKind::kLoopClosure) {
-      ++keyframes[from].loop_factors;
-      ++keyframes[to].loop_factors;
-    } else if (keyframes[to].prev == static_cast<std::int32_t>(from)) {
-      KeyframeNode& node = keyframes[to];
-      if (node.information_from_prev.isZero()) {
-        node.measurement_from_prev = T_from_to;
-      } else {
-        const Vector6d xi = Se3Log(node.measurement_from_prev.inverse() * T_from_to);
-        const Vector6d step =
-            (node.information_from_prev + information).ldlt().solve(information * xi);
-        if (step.allFinite())
-          node.measurement_from_prev = node.measurement_from_prev * Se3Exp(step);
-      }
-      node.information_from_prev += information;
-    }
-    return static_cast<std::uint32_t>(*slot);
-  }
-
-  // Removes the keyframe whose loss costs least: not the origin, not in the local window, not
-  // an end of a loop closure, and with the shortest hop between its neighbours (the most
-  // redundant). Its neighbours are joined by the composition of its relative-pose chain.
-  bool Sparsify() {
-    std::int32_t window_start = newest;
-    for (std::size_t i = 1; i < config.local_window_keyframes && window_start != kNone; ++i) {
-      window_start = keyframes[static_cast<std::size_t>(window_start)].prev;
-    }
-    std::int32_t victim = kNone;
-    double best = 1e300;
-    for (std::int32_t k = keyframes[static_cast<std::size_t>(origin)].next;
-         k != kNone && k != window_start; k = keyframes[static_cast<std::size_t>(k)].next) {
-      const KeyframeNode& node = keyframes[static_cast<std::size_t>(k)];
-      if (node.loop_factors > 0 || node.prev == kNone || node.next == kNone) continue;
-      const double hop = (Pose(static_cast<std::uint32_t>(node.prev)).translation() -
-                          Pose(static_cast<std::uint32_t>(node.next)).translation())
-                             .norm();
-      if (hop < best) {
-        best = hop;
-        victim = k;
-      }
-    }
-    if (victim == kNone) return false;
-    const auto v = static_cast<std::uint32_t>(victim);
-    KeyframeNode& node = keyframes[v];
-    const auto p = static_cast<std::uint32_t>(node.prev), n = static_cast<std::uint32_t>(node.next);
-    // Composition Z = Z_a Z_b of the fused measurements of each hop, with right perturbations:
-    // Sigma_Z = Ad(Z_b^-1) Sigma_a Ad(Z_b^-1)^T + Sigma_b.
-    const Eigen::Isometry3d Z_a = node.measurement_from_prev,
-                            Z_b = keyframes[n].measurement_from_prev;
-    const Matrix6d info_a = node.information_from_prev, info_b = keyframes[n].information_from_prev;
-    Matrix6d composed_information = Matrix6d::Identity() * 1e-6;
-    bool have_information = false;
-    if (info_a.determinant() > 0 && info_b.determinant() > 0) {
-      const Matrix6d Ad = Adjoint(Z_b.inverse());
-      const Matrix6d sigma = Ad * info_a.inverse() * Ad.transpose() + info_b.inverse();
-      composed_information = sigma.inverse();
-      composed_information = 0.5 * (composed_information + composed_information.transpose()).eval();
-      have_information = composed_information.allFinite();
-    }
-    // Detach: forget every factor record on the victim, then let Ceres drop its residuals.
-    for (std::size_t i = 0; i < factor_high_water; ++i) {
-      const FactorRecord& f = factors[i];
-      if (!f.active) continue;
-      const bool touches = (f.kind == FactorKind::kRelative && (f.a == v || f.b == v)) ||
-                           (f.kind == FactorKind::kPlane && f.a == v);
-      if (touches) DropFactor(static_cast<std::int32_t>(i));
-    }
-    problem->RemoveParameterBlock(node.q);
-    problem->RemoveParameterBlock(node.t);
-    node.active = false;
-    keyframes[p].next = static_cast<std::int32_t>(n);
-    keyframes[n].prev = static_cast<std::int32_t>(p);
-    keyframes[n].information_from_prev.setZero();
-    free_keyframe_slots.push_back(victim);
-    --active_keyframes;
-    ++stats.sparsified;
-    if (have_information) {
-      static_cast<void>(
-          AddRelative(p, n, Z_a * Z_b, composed_information, RelativePoseKind::kSparsified));
-    }
-    return true;
-  }
-
-  // Every parameter value in one flat buffer (sized at Init), to undo a solve.
-  void Snapshot(bool restore) {
-    std::size_t i = 0;
-    auto io = [&](double* v, int size) {
-      for (int k = 0; k < size; ++k, ++i) {
-        if (restore)
-          v[k] = snapshot[i];
-        else
-          snapshot[i] = v[k];
-      }
-    };
-    for (std::size_t k = 0; k < keyframe_high_water; ++k) {
-      io(keyframes[k].q, 4);
-      io(keyframes[k].t, 3);
-    }
-    for (std::size_t k = 0; k < plane_count; ++k) {
-      io(planes[k].n, 3);
-      io(planes[k].d, 1);
-    }
-    for (std::size_t k = 0; k < room_count; ++k) io(rooms[k].c, 2);
-    io(floor_c, 2);
-  }
-
-  bool StateFinite() const {
-    for (std::size_t k = 0; k < keyframe_high_water; ++k) {
-      for (double v : keyframes[k].q)
-        if (!std::isfinite(v)) return false;
-      for (double v : keyframes[k].t)
-        if (!std::isfinite(v)) return false;
-    }
-    for (std::size_t k = 0; k < plane_count; ++k) {
-      for (double v : planes[k].n)
-        if (!std::isfinite(v)) return false;
-      if (!std::isfinite(planes[k].d[0])) return false;
-    }
-    for (std::size_t k = 0; k < room_count; ++k) {
-      if (!std::isfinite(rooms[k].c[0]) || !std::isfinite(rooms[k].c[1])) return false;
-    }
-    return std::isfinite(floor_c[0]) && std::isfinite(floor_c[1]);
-  }
-
-  void SetFree(double* block, bool free) {
-    if (!problem->HasParameterBlock(block)) return;
-    const bool constant = problem->IsParameterBlockConstant(block);
-    if (free && constant) problem->SetParameterBlockVariable(block);
-    if (!free && !constant) problem->SetParameterBlockConstant(block);
-  }
-};
 
 SGraph::SGraph() : impl_(std::make_unique<Impl>()) {}
 SGraph::~SGraph() = default;
@@ -441,6 +95,14 @@ Expected<std::uint32_t> SGraph::AddKeyframe(double stamp_s,
     ++m.stats.rejected_stamp;
     return Error{Errc::kOutOfOrder, "keyframe stamp not after the previous keyframe's"};
   }
+  // The store holds max_keyframes + 1: the new keyframe enters before one is sparsified, so
+  // that the local window includes it. Every slot is taken only if the last sparsification
+  // found no keyframe to remove (validation rules that out): try once more, else refuse.
+  if (m.free_keyframe_slots.empty() && m.keyframe_high_water >= m.keyframes.size() &&
+      !m.Sparsify()) {
+    ++m.stats.rejected_keyframes;
+    return Error{Errc::kCapacityExceeded, "s-graph keyframe store full and nothing to sparsify"};
+  }
   std::int32_t slot = kNone;
   if (!m.free_keyframe_slots.empty()) {
     slot = m.free_keyframe_slots.back();
@@ -448,6 +110,8 @@ Expected<std::uint32_t> SGraph::AddKeyframe(double stamp_s,
   } else {
     slot = static_cast<std::int32_t>(m.keyframe_high_water++);
   }
+  MSGRAPHS_ASSERT(slot >= 0 && static_cast<std::size_t>(slot) < m.keyframes.size(),
+                  "s-graph keyframe slot beyond the store");
   KeyframeNode& k = m.keyframes[static_cast<std::size_t>(slot)];
   k = KeyframeNode{};
   const Eigen::Quaterniond q(T_map_keyframe.linear());
@@ -470,7 +134,9 @@ Expected<std::uint32_t> SGraph::AddKeyframe(double stamp_s,
     m.problem->SetParameterBlockConstant(k.t);
   }
   ++m.active_keyframes;
-  if (m.active_keyframes > m.config.max_keyframes) static_cast<void>(m.Sparsify());
+  // A failed sparsification leaves the spare slot taken; the next AddKeyframe tries again and
+  // refuses (counted) if it fails again.
+  if (m.active_keyframes > m.config.max_keyframes && !m.Sparsify()) ++m.stats.sparsify_failed;
   m.stats.keyframes_peak = std::max(m.stats.keyframes_peak, m.active_keyframes);
   return static_cast<std::uint32_t>(slot);
 }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 
+#include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/perception/deskew.hpp"
 
@@ -206,15 +207,16 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
     for (std::uint32_t k = 0; k < graph_.keyframe_slots() && count < nearby_.size(); ++k) {
       if (!graph_.keyframe_active(k)) continue;
       const Eigen::Vector2d p = graph_.keyframe_pose(k).translation().head<2>();
-      const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+      const double t =
+          ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
       const double distance_m = (p - (a + t * ab)).norm();
       if (distance_m <= search.map_radius_m) nearby_[count++] = {distance_m, k};
     }
     std::sort(nearby_.begin(), nearby_.begin() + static_cast<std::ptrdiff_t>(count),
               [](const auto& x, const auto& y) { return x.first < y.first; });
     for (std::size_t i = 0; i < count; ++i) recent_scratch_[i] = nearby_[i].second;
-    if (count == 0 ||
-        !BuildMapFrom(last_keyframe_, std::span<const std::uint32_t>(recent_scratch_.data(), count)))
+    if (count == 0 || !BuildMapFrom(last_keyframe_,
+                                    std::span<const std::uint32_t>(recent_scratch_.data(), count)))
       return Error{Errc::kDegenerate, "relocalise: no map near the search"};
   }
   const Eigen::Vector3d span = to.translation() - from.translation();
@@ -234,7 +236,8 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
   };
   std::array<Ranked, 8> ranked;
   std::size_t ranked_count = 0;
-  const std::size_t keep = std::min<std::size_t>(ranked.size(), std::max<std::size_t>(1, search.registrations));
+  const std::size_t keep =
+      std::min<std::size_t>(ranked.size(), std::max<std::size_t>(1, search.registrations));
   const std::size_t stride = std::max<std::size_t>(1, down_.size() / 400);
   const double inv_two_sigma2 = 1.0 / (2.0 * 0.15 * 0.15);
   Relocalisation best;
@@ -369,18 +372,25 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   Stage(observer, MapperStage::kScanMatching);
   if (have_keyframe_ && !matched) T_map_new = graph_.keyframe_pose(last_keyframe_) * delta;
   auto added = graph_.AddKeyframe(scan.end_s, T_map_new);
-  if (!added) return added.error();
+  if (!added) {
+    ++stats_.keyframes_refused;
+    return added.error();
+  }
   const std::uint32_t id = *added;
+  // The graph hands out ids below its store (max_keyframes + 1), which sizes ours too.
+  MSGRAPHS_ASSERT(id < sequence_.size() && id < keyframe_odometry_.size(),
+                  "keyframe id beyond the mapper's per-keyframe stores");
   sequence_[id] = next_sequence_++;
   keyframe_odometry_[id] = T_odom_now;
   if (have_keyframe_) {
     if (across_gap) ++stats_.odometry_gap_keyframes;
-    static_cast<void>(graph_.AddRelativePose(last_keyframe_, id, delta,
-                                             OdometryInformation(delta, across_gap),
-                                             RelativePoseKind::kOdometry));
-    if (matched) {
-      static_cast<void>(graph_.AddRelativePose(last_keyframe_, id, T_last_new, match_information,
-                                               RelativePoseKind::kScanMatch));
+    if (!graph_.AddRelativePose(last_keyframe_, id, delta, OdometryInformation(delta, across_gap),
+                                RelativePoseKind::kOdometry)) {
+      ++stats_.chain_factors_refused;
+    }
+    if (matched && !graph_.AddRelativePose(last_keyframe_, id, T_last_new, match_information,
+                                           RelativePoseKind::kScanMatch)) {
+      ++stats_.chain_factors_refused;
     }
     path_m_ += delta.translation().norm();
   }

@@ -172,8 +172,10 @@ void PlaneMapper::MapWalls(const SGraph& graph,
     const Eigen::Vector2d foot = -w.d * w.normal;
     w.a = foot + dir * lo;
     w.b = foot + dir * hi;
-    if (!walls.try_push_back(w)) break;
-    static_cast<void>(ids.try_push_back(id));
+    // walls[i] is the graph's plane ids[i]: both have room, or neither takes it.
+    if (walls.full() || ids.full()) break;
+    walls.push_back(w);
+    ids.push_back(id);
   }
 }
 

@@ -49,9 +49,14 @@ void RoomMapper::TieSameWalls(SGraph& graph, const MapRoom& mapped, const MapRoo
     const MapPlane pa = graph.plane(ua), pb = graph.plane(ub);
     if (pa.normal.dot(pb.normal) < cos_same || std::fabs(pa.d - pb.d) > config_.same_wall_offset_m)
       continue;
+    // A pair that could not be remembered would be tied again at every update, one more
+    // factor each time: refuse it (counted) instead.
+    if (wall_pairs_.full()) {
+      ++stats_.wall_wall_refused;
+      continue;
+    }
     if (!graph.AddWallWall(ua, ub)) continue;
-    static_cast<void>(wall_pairs_.try_push_back(
-        (static_cast<std::uint64_t>(std::min(ua, ub)) << 32) | std::max(ua, ub)));
+    wall_pairs_.push_back((static_cast<std::uint64_t>(std::min(ua, ub)) << 32) | std::max(ua, ub));
     ++stats_.wall_wall;
   }
 }
@@ -60,9 +65,10 @@ Status RoomMapper::Update(const FreeSpaceGrid& grid, const PlaneMapper& planes, 
   ++stats_.updates;
   planes.MapWalls(graph, config_.min_wall_observations, walls_, wall_ids_);
   if (walls_.size() < 2) return Ok();
-  static_cast<void>(segmenter_.Segment(grid, config_.segmentation, regions_, walls_.span()));
-  static_cast<void>(
-      segmenter_.DetectRooms(grid, regions_.span(), walls_.span(), config_.detection, detected_));
+  // Out of capacity, both keep what fit (the regions, the rooms found so far): counted.
+  if (!segmenter_.Segment(grid, config_.segmentation, regions_, walls_.span())) ++stats_.truncated;
+  if (!segmenter_.DetectRooms(grid, regions_.span(), walls_.span(), config_.detection, detected_))
+    ++stats_.truncated;
   for (const DetectedRoom& d : detected_) {
     ++stats_.detections;
     MapRoom room;

@@ -16,7 +16,10 @@
 //
 // Bounded: keyframes, planes, rooms and factors have capacities from the config. When the
 // keyframe store is full, a keyframe is sparsified: removed and its neighbours joined by the
-// composition of its two relative-pose factors (docs/s-graph.md says which one and why).
+// composition of its two relative-pose hops; its loop closures are carried to a neighbour
+// through the composed hop (docs/s-graph.md says which one and why). There is always one to
+// remove, so the store never overflows: AddKeyframe would refuse (counted) rather than write
+// past it.
 //
 // Bad input never enters: non-finite or non-rigid poses, stamps that go backwards or repeat,
 // indefinite information, a plane seen from behind, factors between missing nodes; each is
@@ -124,6 +127,17 @@ struct SGraphSolveReport {
 
 struct SGraphStats {
   std::size_t keyframes = 0, keyframes_peak = 0, sparsified = 0;
+  // Sparsification when loops are everywhere (docs/s-graph.md): victims that carried a loop
+  // closure (taken only when no keyframe without one was left), relative factors carried from a
+  // victim to a neighbour through the composed hop, of them fused into a parallel factor already
+  // there, and constraints that could not be carried over (a hop without a measurement, a
+  // composition that is not positive definite, a full factor store): counted, and lost.
+  std::size_t sparsified_with_loops = 0, sparsify_carried = 0, sparsify_merged = 0,
+              sparsify_dropped = 0;
+  /// Keyframes refused because the store was full and nothing could be sparsified, and
+  /// sparsifications that found nothing to remove. Both stay 0 under a validated config (a
+  /// keyframe always lies between the origin and the local window); never a write past the store.
+  std::uint64_t rejected_keyframes = 0, sparsify_failed = 0;
   std::size_t planes = 0, rooms = 0, floors = 0;
   std::size_t factors = 0, factors_peak = 0;
   std::array<std::size_t, 4> relative_factors{};  ///< by RelativePoseKind
@@ -153,7 +167,9 @@ class SGraph {
 
   /// A new keyframe with its initial estimate. The first one becomes the origin (held fixed).
   /// kOutOfOrder when `stamp_s` is not after the last keyframe's; kInvalidArgument for a
-  /// non-rigid or non-finite pose. Sparsifies first when the store is full.
+  /// non-rigid or non-finite pose. When the store is full, one keyframe is sparsified after the
+  /// new one is in (the local window includes it); kCapacityExceeded (rejected_keyframes) only
+  /// if nothing could be, which a validated config rules out.
   Expected<std::uint32_t> AddKeyframe(double stamp_s, const Eigen::Isometry3d& T_map_keyframe);
 
   /// Relative pose measurement T_from_to with its information over [t; rotation vector].

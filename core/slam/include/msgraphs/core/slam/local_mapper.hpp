@@ -129,6 +129,12 @@ struct LocalMapperStats {
   std::uint64_t scan_match_rejected_fitness = 0, scan_match_rejected_overlap = 0,
                 scan_match_rejected_diverged = 0, scan_match_rejected_failed = 0;
   std::uint64_t loop_closures = 0, full_solves = 0;
+  /// Keyframes the graph refused (its store full with nothing to sparsify, which a validated
+  /// config rules out): the scan is skipped and the next one tries again.
+  std::uint64_t keyframes_refused = 0;
+  /// Odometry or scan-matching factors the graph refused (its factor store full): the keyframe
+  /// then rests on whichever of the two the graph took, or on its planes alone.
+  std::uint64_t chain_factors_refused = 0;
   std::size_t plane_priors = 0;            ///< external wall priors in the graph now
   std::uint64_t plane_priors_refused = 0;  ///< beyond max_plane_priors, or refused by the graph
   std::uint64_t floors_found = 0;          ///< keyframes whose floor only the floor search found
@@ -151,7 +157,7 @@ struct RelocaliseSearch {
   /// Keyframes within this distance of the segment make the map searched, nearest first, as
   /// many as the local map holds (the robot may have walked beyond the last few keyframes).
   double map_radius_m = 10.0;
-  std::size_t registrations = 6;      ///< the best-scored seeds registered (at most 8)
+  std::size_t registrations = 6;  ///< the best-scored seeds registered (at most 8)
 };
 
 struct Relocalisation {
@@ -198,8 +204,10 @@ class LocalMapper {
   /// T_odom_base.
   Eigen::Isometry3d T_map_odom() const { return T_map_odom_; }
   /// Encoder odometry at a keyframe (for the encoder-only baseline of the same keyframes).
+  /// Identity for an id beyond the graph's store.
   Eigen::Isometry3d keyframe_odometry(std::uint32_t keyframe) const {
-    return keyframe_odometry_[keyframe];
+    return keyframe < keyframe_odometry_.size() ? keyframe_odometry_[keyframe]
+                                                : Eigen::Isometry3d::Identity();
   }
   const LocalMapperStats& stats() const { return stats_; }
   const PlaneMapper& plane_mapper() const { return planes_mapper_; }

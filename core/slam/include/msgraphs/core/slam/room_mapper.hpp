@@ -38,6 +38,9 @@ struct RoomMapperConfig {
 struct RoomMapperStats {
   std::uint64_t updates = 0, detections = 0, created = 0, matched = 0, upgraded = 0, wall_wall = 0,
                 rejected = 0;
+  std::uint64_t wall_wall_refused = 0;  ///< the wall-pair memory (4 per room) was full
+  /// Updates whose segmentation or detection failed or ran out of capacity (kept what fit).
+  std::uint64_t truncated = 0;
 };
 
 class RoomMapper {

@@ -1,0 +1,255 @@
+// SPDX-License-Identifier: MIT
+// S-Graph sparsification: one keyframe out when the keyframe store is full (docs/s-graph.md).
+//
+// The victim's neighbours p and n are joined by the composition of its two chain hops, and every
+// other relative factor on it (a loop closure) is carried to a neighbour through the hop that
+// leads there. A hop shared by k composed factors enters each with k times its covariance
+// (covariance intersection with equal weights): the factors are then never jointly more certain
+// than the one measurement they share, whatever its correlation with itself.
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <limits>
+
+#include "msgraphs/base/assert.hpp"
+#include "msgraphs/core/geometry/se3.hpp"
+#include "s_graph_impl.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+using sgraph::Adjoint;
+
+// Covariance of an information matrix (or the reverse), symmetrised; false when not positive
+// definite.
+bool Invert(const Matrix6d& m, Matrix6d& inverse) {
+  if (!m.allFinite()) return false;
+  const Eigen::LLT<Matrix6d> llt(m);
+  if (llt.info() != Eigen::Success) return false;
+  inverse = llt.solve(Matrix6d::Identity());
+  inverse = 0.5 * (inverse + inverse.transpose()).eval();
+  return inverse.allFinite();
+}
+
+// One side of the victim: the fused chain measurement from a keyframe to the next.
+struct Hop {
+  Eigen::Isometry3d Z = Eigen::Isometry3d::Identity();  // T_from_to
+  Matrix6d covariance = Matrix6d::Zero();
+  double log_det_information = -std::numeric_limits<double>::infinity();
+  bool usable = false;
+  double uses = 0;  // composed factors that rest on it
+};
+
+Hop MakeHop(const KeyframeNode& to) {
+  Hop h;
+  h.Z = to.measurement_from_prev;
+  if (to.information_from_prev.isZero(0.0)) return h;  // no measurement: the chain is cut here
+  const Eigen::LLT<Matrix6d> llt(to.information_from_prev);
+  if (llt.info() != Eigen::Success || !Invert(to.information_from_prev, h.covariance)) return h;
+  h.log_det_information = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+  h.usable = std::isfinite(h.log_det_information);
+  return h;
+}
+
+enum class Via : std::uint8_t { kPrev, kNext, kNowhere };
+
+// Which hop carries a factor between the victim and `partner`: never the one leading to the
+// partner itself; otherwise the more informative one (the smaller uncertainty volume).
+Via Route(std::uint32_t partner, std::uint32_t p, std::uint32_t n, const Hop& a, const Hop& b) {
+  const bool to_p = partner != p && a.usable, to_n = partner != n && b.usable;
+  if (to_p && to_n) return b.log_det_information >= a.log_det_information ? Via::kNext : Via::kPrev;
+  if (to_n) return Via::kNext;
+  if (to_p) return Via::kPrev;
+  return Via::kNowhere;
+}
+
+}  // namespace
+
+void SGraph::Impl::RelativeMeasurement(const FactorRecord& f,
+                                       Eigen::Isometry3d& T_a_b,
+                                       Matrix6d& information) const {
+  MSGRAPHS_ASSERT(f.active && f.kind == FactorKind::kRelative, "not a relative-pose factor");
+  // Every relative factor is built by AddRelative as a RelativePoseCost.
+  const auto* cost =
+      static_cast<const sgraph::RelativePoseCost*>(problem->GetCostFunctionForResidualBlock(f.id));
+  const sgraph::RelativePoseResidual& r = cost->functor();
+  T_a_b = Eigen::Isometry3d::Identity();
+  T_a_b.linear() = r.q_z.toRotationMatrix();
+  T_a_b.translation() = r.t_z;
+  information = r.sqrt_information.transpose() * r.sqrt_information;
+}
+
+bool SGraph::Impl::AddOrFuseRelative(std::uint32_t from,
+                                     std::uint32_t to,
+                                     const Eigen::Isometry3d& T_from_to,
+                                     const Matrix6d& information,
+                                     RelativePoseKind kind,
+                                     bool& fused) {
+  fused = false;
+  // A parallel factor of the same kind: one factor with both measurements, so that loops
+  // carried again and again over an endless patrol do not pile up between the same keyframes.
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!f.active || f.kind != FactorKind::kRelative || f.chain || f.relative != kind ||
+        !((f.a == from && f.b == to) || (f.a == to && f.b == from))) {
+      continue;
+    }
+    Eigen::Isometry3d T;
+    Matrix6d info;
+    RelativeMeasurement(f, T, info);
+    if (f.a == to) {  // as from -> to: Sigma of T^-1 is Ad(T) Sigma Ad(T)^T
+      const Matrix6d Ad_inv = Adjoint(T.inverse());
+      info = (Ad_inv.transpose() * info * Ad_inv).eval();
+      T = T.inverse();
+    }
+    Matrix6d sum = info + information;
+    sum = 0.5 * (sum + sum.transpose()).eval();
+    const Eigen::Isometry3d Z = sgraph::Fuse(T, info, T_from_to, information);
+    RemoveFactor(static_cast<std::int32_t>(i));
+    fused = static_cast<bool>(AddRelative(from, to, Z, sum, kind));
+    return fused;
+  }
+  return static_cast<bool>(AddRelative(from, to, T_from_to, information, kind));
+}
+
+bool SGraph::Impl::Sparsify() {
+  if (origin == kNone || newest == kNone) return false;
+  std::int32_t window_start = newest;
+  for (std::size_t i = 1; i < config.local_window_keyframes && window_start != kNone; ++i) {
+    window_start = keyframes[static_cast<std::size_t>(window_start)].prev;
+  }
+  if (window_start == kNone) return false;
+  // The victim, cheapest loss first: no loop closure on it; then loops that can be carried
+  // (a hop with a measurement to carry them through), fewest first; then the rest. Within
+  // that, the shortest hop between its neighbours (the most redundant keyframe). Never the
+  // origin, never in the local window.
+  std::int32_t victim = kNone;
+  int best_tier = 3;
+  std::uint32_t best_loops = 0;
+  double best_hop = 0;
+  for (std::int32_t k = keyframes[static_cast<std::size_t>(origin)].next;
+       k != kNone && k != window_start; k = keyframes[static_cast<std::size_t>(k)].next) {
+    const KeyframeNode& node = keyframes[static_cast<std::size_t>(k)];
+    if (node.prev == kNone || node.next == kNone) continue;
+    const bool carriable =
+        !node.information_from_prev.isZero(0.0) ||
+        !keyframes[static_cast<std::size_t>(node.next)].information_from_prev.isZero(0.0);
+    const int tier = node.loop_factors == 0 ? 0 : (carriable ? 1 : 2);
+    const double hop = (Pose(static_cast<std::uint32_t>(node.prev)).translation() -
+                        Pose(static_cast<std::uint32_t>(node.next)).translation())
+                           .norm();
+    const bool better =
+        tier < best_tier ||
+        (tier == best_tier &&
+         (node.loop_factors < best_loops || (node.loop_factors == best_loops && hop < best_hop)));
+    if (better) {
+      victim = k;
+      best_tier = tier;
+      best_loops = node.loop_factors;
+      best_hop = hop;
+    }
+  }
+  if (victim == kNone) return false;
+  const auto v = static_cast<std::uint32_t>(victim);
+  const auto p = static_cast<std::uint32_t>(keyframes[v].prev);
+  const auto n = static_cast<std::uint32_t>(keyframes[v].next);
+  const bool had_loops = keyframes[v].loop_factors > 0;
+  Hop a = MakeHop(keyframes[v]), b = MakeHop(keyframes[n]);  // p -> v, v -> n
+  const bool compose = a.usable && b.usable;
+  const auto touches = [v](const FactorRecord& f) {
+    return f.active && f.kind == FactorKind::kRelative && !f.chain && (f.a == v || f.b == v);
+  };
+  // 1. How many composed factors rest on each hop.
+  a.uses = b.uses = compose ? 1.0 : 0.0;
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!touches(f)) continue;
+    const Via via = Route(f.a == v ? f.b : f.a, p, n, a, b);
+    if (via == Via::kPrev) a.uses += 1;
+    if (via == Via::kNext) b.uses += 1;
+  }
+  // 2. Carry every factor that is not a chain hop (loops) from v to a neighbour t, as
+  //    partner k -> t. Each is removed before its replacement is added, so the factor store
+  //    always has room. The replacement touches neither v nor a factor still to be visited.
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!touches(f)) continue;
+    const std::uint32_t k = f.a == v ? f.b : f.a;
+    const RelativePoseKind kind = f.relative;
+    const Via via = Route(k, p, n, a, b);
+    Eigen::Isometry3d T;
+    Matrix6d information, covariance;
+    RelativeMeasurement(f, T, information);
+    const bool from_victim = f.a == v;
+    RemoveFactor(static_cast<std::int32_t>(i));
+    if (via == Via::kNowhere || !Invert(information, covariance)) {
+      ++stats.sparsify_dropped;
+      continue;
+    }
+    // As k -> v: the inverse of T_v_k has covariance Ad(T) Sigma Ad(T)^T.
+    Eigen::Isometry3d Z_kv = T;
+    if (from_victim) {
+      const Matrix6d Ad = Adjoint(T);
+      covariance = (Ad * covariance * Ad.transpose()).eval();
+      Z_kv = T.inverse();
+    }
+    Eigen::Isometry3d Z_kt;
+    Matrix6d sigma_kt;
+    std::uint32_t t = 0;
+    if (via == Via::kNext) {  // Z_kn = Z_kv B: Ad(B^-1) Sigma_kv Ad(B^-1)^T + uses_b Sigma_b
+      const Matrix6d Ad = Adjoint(b.Z.inverse());
+      Z_kt = Z_kv * b.Z;
+      sigma_kt = Ad * covariance * Ad.transpose() + b.uses * b.covariance;
+      t = n;
+    } else {  // Z_kp = Z_kv A^-1: Ad(A) (Sigma_kv + uses_a Sigma_a) Ad(A)^T
+      const Matrix6d Ad = Adjoint(a.Z);
+      Z_kt = Z_kv * a.Z.inverse();
+      sigma_kt = Ad * (covariance + a.uses * a.covariance) * Ad.transpose();
+      t = p;
+    }
+    Matrix6d information_kt;
+    bool fused = false;
+    if (Invert(sigma_kt, information_kt) &&
+        AddOrFuseRelative(k, t, Z_kt, information_kt, kind, fused)) {
+      ++stats.sparsify_carried;
+      if (fused) ++stats.sparsify_merged;
+    } else {
+      ++stats.sparsify_dropped;
+    }
+  }
+  // 3. Detach: forget the chain hops and plane observations on v (their measurements are in
+  //    the hops, or go with v), then let Ceres drop their residuals with v's parameters.
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!f.active) continue;
+    if ((f.kind == FactorKind::kRelative && (f.a == v || f.b == v)) ||
+        (f.kind == FactorKind::kPlane && f.a == v)) {
+      DropFactor(static_cast<std::int32_t>(i));
+    }
+  }
+  KeyframeNode& node = keyframes[v];
+  problem->RemoveParameterBlock(node.q);
+  problem->RemoveParameterBlock(node.t);
+  node.active = false;
+  node.loop_factors = 0;
+  keyframes[p].next = static_cast<std::int32_t>(n);
+  keyframes[n].prev = static_cast<std::int32_t>(p);
+  keyframes[n].information_from_prev.setZero();
+  free_keyframe_slots.push_back(victim);  // capacity reserved at Init: no allocation
+  --active_keyframes;
+  ++stats.sparsified;
+  if (had_loops) ++stats.sparsified_with_loops;
+  // 4. Join the neighbours: Z = A B, Sigma = Ad(B^-1) uses_a Sigma_a Ad(B^-1)^T + uses_b Sigma_b.
+  //    Without a measurement on one side the chain was already cut there: nothing to join.
+  if (compose) {
+    const Matrix6d Ad = Adjoint(b.Z.inverse());
+    const Matrix6d sigma = Ad * (a.uses * a.covariance) * Ad.transpose() + b.uses * b.covariance;
+    Matrix6d information;
+    if (!Invert(sigma, information) ||
+        !AddRelative(p, n, a.Z * b.Z, information, RelativePoseKind::kSparsified)) {
+      ++stats.sparsify_dropped;
+    }
+  }
+  return true;
+}
+
+}  // namespace msgraphs::core
