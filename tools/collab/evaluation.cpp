@@ -163,15 +163,28 @@ Evaluation Evaluate(const Mission& mission,
       out.matches.accepted += v.matches_accepted;
       out.matches.wrong += v.matches_wrong;
       out.matches.unchecked += v.matches_unchecked;
+      // Every merged moment, against the truth.
+      for (const MergedEstimate& m : v.history.estimates) {
+        const OriginError e = CheckOrigin(ea, eb, m.T_viewer_robot);
+        if (!e.checked) continue;
+        if (!v.worst_origin.checked || e.translation_m > v.worst_origin.translation_m) {
+          const double rotation = std::max(v.worst_origin.rotation_deg, e.rotation_deg);
+          v.worst_origin = e;
+          v.worst_origin.rotation_deg = rotation;
+        }
+        v.worst_origin.rotation_deg = std::max(v.worst_origin.rotation_deg, e.rotation_deg);
+        if (!v.first_wrong_s && (e.translation_m > config.wrong_origin_m || e.rotation_deg > config.wrong_origin_deg))
+          v.first_wrong_s = m.mission_time_s;
+      }
       if (!v.merged) {
-        v.verdict = Verdict::kNotMerged;
+        v.verdict = v.first_wrong_s ? Verdict::kWrong : Verdict::kNotMerged;
         v.origin.reason = "not merged";
         aggregated.AddNotMerged(b->id());
       } else {
         v.T_viewer_robot = mission.Origin(*a, b->index);
         v.origin = CheckOrigin(ea, eb, v.T_viewer_robot);
         v.verdict = !v.origin.checked ? Verdict::kUnchecked
-                    : v.origin.translation_m > config.wrong_origin_m ||
+                    : v.first_wrong_s || v.origin.translation_m > config.wrong_origin_m ||
                             v.origin.rotation_deg > config.wrong_origin_deg
                         ? Verdict::kWrong
                         : Verdict::kRight;

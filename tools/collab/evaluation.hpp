@@ -58,6 +58,10 @@ struct ViewEvaluation {
   ViewHistory history;
   Eigen::Isometry3d T_viewer_robot = Eigen::Isometry3d::Identity();  ///< when merged
   OriginError origin;
+  /// The worst origin error while merged, over every exchange, and when it was first wrong
+  /// (a wrong merge undone later still counts as wrong).
+  OriginError worst_origin;
+  std::optional<double> first_wrong_s;
   Verdict verdict = Verdict::kNotMerged;
   std::size_t factors = 0;
   std::size_t matches_accepted = 0, matches_wrong = 0, matches_unchecked = 0;

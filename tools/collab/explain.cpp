@@ -27,8 +27,8 @@ std::vector<core::Hypothesis> Symmetries(const core::WallIndex& walls, const cor
   return out;
 }
 
-void Picture(const core::FreeSpaceSummary& f, const core::WallIndex& other, const core::PlanarTransform& T,
-             double clearance_m, const std::string& path) {
+void Picture(const core::FreeSpaceSummary& f, const core::WallIndex& other, const core::FreeSpaceSummary& other_free,
+             const core::PlanarTransform& T, double clearance_m, const std::string& path) {
   if (f.empty()) return;
   const int w = f.width(), h = f.height();
   std::vector<unsigned char> image(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3);
@@ -65,6 +65,15 @@ void Picture(const core::FreeSpaceSummary& f, const core::WallIndex& other, cons
       p[0] = 0;
       p[1] = 60;
       p[2] = 255;
+    });
+  }
+  // The other robot's openings: magenta, dark red where they fall on a cell seen occupied.
+  for (const core::Opening& o : other_free.openings()) {
+    draw(T * o.a, T * o.b, [&](unsigned char* p, const Eigen::Vector2d& q) {
+      const bool solid = f.state_at(q) == core::SummaryCell::kOccupied && !f.NearOpening(q, 0.3);
+      p[0] = solid ? 140 : 255;
+      p[1] = 0;
+      p[2] = solid ? 0 : 255;
     });
   }
   if (std::FILE* file = std::fopen(path.c_str(), "wb")) {
@@ -162,8 +171,9 @@ std::vector<ViewExplanation> ExplainViews(const Mission& mission, const Evaluati
       }
       if (!pictures_dir.empty()) {
         const std::string stem = pictures_dir + "/robot" + std::to_string(v.robot) + "_in_robot" + std::to_string(v.viewer);
-        Picture(sa.free_space(), walls_b, e.truth.T_a_b, config.merge.conflict.clearance_m, stem + ".ppm");
-        Picture(sb.free_space(), own[a], e.truth.T_a_b.inverse(), config.merge.conflict.clearance_m,
+        Picture(sa.free_space(), walls_b, sb.free_space(), e.truth.T_a_b, config.merge.conflict.clearance_m,
+                stem + ".ppm");
+        Picture(sb.free_space(), own[a], sa.free_space(), e.truth.T_a_b.inverse(), config.merge.conflict.clearance_m,
                 stem + "_back.ppm");
       }
     }

@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   const std::vector<ViewExplanation> explanations = ExplainViews(mission, evaluation, o.explain_dir);
   const ReportInput report{o, mission, run, evaluation, explanations};
 
-  if (!o.out_dir.empty() && !WriteOutputs(o.out_dir, evaluation, run, error)) {
+  if (!o.out_dir.empty() && !WriteOutputs(o.out_dir, mission, evaluation, run, error)) {
     std::fprintf(stderr, "collab: %s\n", error.c_str());
     return 1;
   }

@@ -4,6 +4,7 @@
 // merge the session withdrew, and any merge after it).
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -17,9 +18,17 @@ struct MergeChange {
   bool merged = false;
 };
 
+struct MergedEstimate {
+  double mission_time_s = 0;
+  Eigen::Isometry3d T_viewer_robot = Eigen::Isometry3d::Identity();
+};
+
 struct ViewHistory {
   std::optional<double> first_merge_s;  ///< the first exchange after which A had B merged
   std::vector<MergeChange> changes;     ///< every change of merged, in order
+  /// A's estimate of B's origin after every exchange while merged (judged against the truth at
+  /// the end: a merge that was wrong for a while counts, even if undone later).
+  std::vector<MergedEstimate> estimates;
   std::size_t unmerges() const {
     std::size_t n = 0;
     for (const MergeChange& c : changes) n += c.merged ? 0 : 1;
@@ -38,6 +47,7 @@ class MergeTracker {
         if (a == b) continue;
         ViewHistory& h = at(a->index, b->index);
         const bool merged = mission.Merged(*a, b->index);
+        if (merged) h.estimates.push_back({mission_time_s, mission.Origin(*a, b->index)});
         const bool was = !h.changes.empty() && h.changes.back().merged;
         if (merged == was) continue;
         h.changes.push_back({mission_time_s, merged});

@@ -45,6 +45,15 @@ void Mission::Exchange(double now_s) {
     }
     Deliver();
   }
+  std::vector<core::MergeLogEntry> entries(64);
+  for (auto& r : robots) {
+    for (;;) {
+      const std::uint64_t after = r->merge_log.empty() ? 0 : r->merge_log.back().sequence;
+      const std::size_t n = r->session.MergeLog(after, entries);
+      if (n == 0) break;
+      r->merge_log.insert(r->merge_log.end(), entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+  }
   if (!feedback) return;
   for (auto& r : robots) {
     const std::size_t n = r->session.PlanePriors(priors);

@@ -3,14 +3,17 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
+#include "msgraphs/runtime/outputs/merge_log_csv.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "radio.hpp"
 
 namespace msgraphs::tools::collab {
 
 bool WriteOutputs(const std::string& out_dir,
+                  const Mission& mission,
                   const Evaluation& evaluation,
                   const MissionRun& run,
                   std::string& error) {
@@ -25,6 +28,18 @@ bool WriteOutputs(const std::string& out_dir,
         error = "cannot write " + path.string();
         return false;
       }
+    }
+  }
+  for (const auto& r : mission.robots) {
+    if (mission.keyframes) break;
+    const fs::path path = fs::path(out_dir) / ("merge_log_robot" + std::to_string(r->id()) + ".csv");
+    std::ofstream log(path);
+    log.precision(9);
+    runtime::outputs::WriteMergeLogHeader(log, r->id(), "mission time");
+    runtime::outputs::WriteMergeLogRows(log, r->merge_log);
+    if (!log) {
+      error = "cannot write " + path.string();
+      return false;
     }
   }
   const fs::path csv = fs::path(out_dir) / "bytes.csv";

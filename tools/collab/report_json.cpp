@@ -146,6 +146,9 @@ void WriteViews(JsonWriter& json, const Evaluation& ev, const std::vector<ViewEx
     }
     json.EndObject();
     json.Field("verdict", Key(v.verdict));
+    json.Field("first_wrong_s", v.first_wrong_s);
+    json.Field("worst_origin_error_m", v.worst_origin.checked ? v.worst_origin.translation_m : 0.0);
+    json.Field("worst_origin_error_deg", v.worst_origin.checked ? v.worst_origin.rotation_deg : 0.0);
     json.Field("factors", v.factors);
     json.Key("matches");
     json.BeginObject();

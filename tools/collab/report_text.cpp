@@ -102,6 +102,9 @@ void ViewTable(const ReportInput& in, std::string& out) {
         matches);
     if (v.merged && !v.origin.checked)
       Add(out, "    (origin not checked: %s)\n", v.origin.reason.c_str());
+    if (v.first_wrong_s)
+      Add(out, "    (wrong from %.1f s: origin off by up to %.3f m, %.2f deg while merged)\n", *v.first_wrong_s,
+          v.worst_origin.translation_m, v.worst_origin.rotation_deg);
   }
   for (const ViewExplanation& e : in.explanations) {
     if (!e.checked) {

@@ -54,6 +54,8 @@ struct Robot {
   const char* delay_source = "none";  ///< "none", "mission.txt" or "--delay-s"
   core::LocalMapper mapper;
   core::CollabSession session;
+  /// Every merge decision its session logged (drained after each exchange), for --out.
+  std::vector<core::MergeLogEntry> merge_log;
   KeyframeBaselineState baseline;
   std::vector<StampedPose> truth;  ///< ground_truth.tum as read (empty when absent)
 };

@@ -59,9 +59,10 @@ void CollabSession::Impl::Log(const Peer& p, MergeEvent event) {
   e.event = event;
   const MergeDecision& d = p.decision;
   e.verdict = d.verdict;
-  if (d.has_leader) {
-    e.T_self_peer = d.leader.T_a_b.ToIsometry(floor_z_m - PeerFloor(p));
-    e.leader = Evidence(d.leader);
+  if (d.has_leader || d.has_best_refuted) {
+    const Hypothesis& h = d.has_leader ? d.leader : d.best_refuted;
+    e.T_self_peer = h.T_a_b.ToIsometry(floor_z_m - PeerFloor(p));
+    e.leader = Evidence(h);
   }
   e.has_rival = d.has_rival;
   if (d.has_rival) e.rival = Evidence(d.rival);

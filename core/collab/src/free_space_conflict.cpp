@@ -40,12 +40,27 @@ bool InDoorwayOf(const WallIndex& walls, const Eigen::Vector2d& a, const Eigen::
   return right_start - left_end <= c.max_opening_m;
 }
 
+// y saw an opening of its own on the same line within `reach_m` of the segment a-b: the two
+// robots saw one door, its extent differently (from another side, obliquely, in part).
+bool SameDoorway(const FreeSpaceSummary& y, const Eigen::Vector2d& a, const Eigen::Vector2d& b, double line_m,
+                 double reach_m) {
+  const double length = (b - a).norm();
+  if (length <= 0) return false;
+  const Eigen::Vector2d u = (b - a) / length, n(-u.y(), u.x());
+  for (const Opening& o : y.openings()) {
+    if (std::fabs(n.dot(o.a - a)) > line_m || std::fabs(n.dot(o.b - a)) > line_m) continue;
+    const double s0 = std::min(u.dot(o.a - a), u.dot(o.b - a)), s1 = std::max(u.dot(o.a - a), u.dot(o.b - a));
+    if (s1 >= -reach_m && s0 <= length + reach_m) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Status FreeSpaceConflictConfig::Validate() const {
   if (!(clearance_m > 0) || !(sample_step_m > 0.01 && sample_step_m <= 1.0) || !(opening_margin_m >= 0) ||
       !(extent_tolerance_m >= 0) || !(max_opening_m >= 0) ||
-      !(door_solid_share > 0 && door_solid_share <= 1) || !(door_wall_distance_m > 0)) {
+      !(door_solid_share > 0 && door_solid_share <= 1) || !(min_stretch_m >= 0) || !(door_wall_distance_m > 0)) {
     return Error{Errc::kInvalidConfig, "free-space conflict: distances and shares must be positive"};
   }
   return Ok();
@@ -65,13 +80,25 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
     const Eigen::Vector2d b = T_y_x * (w.b - c.extent_tolerance_m * dir);
     const Eigen::Vector2d n_y = T_y_x.R() * w.n;
     const auto n = static_cast<int>(std::ceil(inner / step));
+    // Contiguous stretches in seen-through space of at least min_stretch_m count: a wrong
+    // transform lays walls across free space, the maps' own noise leaves a short stretch here
+    // and there (an extent grown past a door, a furniture face one robot mapped as a wall).
+    int run = 0;
+    const auto min_run = static_cast<int>(std::ceil(c.min_stretch_m / (inner / n)));
+    auto close_run = [&]() {
+      if (run >= min_run) out.walls_in_free_m += inner * run / n;
+      run = 0;
+    };
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d p = a + (b - a) * ((i + 0.5) / n);
-      if (static_cast<double>(summary_y.clearance_m(p)) < c.clearance_m) continue;
-      if (summary_y.NearOpening(p, c.opening_margin_m)) continue;
-      if (InDoorwayOf(walls_y, a, b, p, n_y, c)) continue;
-      out.walls_in_free_m += inner / n;
+      const bool in_free = static_cast<double>(summary_y.clearance_m(p)) >= c.clearance_m &&
+                           !summary_y.NearOpening(p, c.opening_margin_m) && !InDoorwayOf(walls_y, a, b, p, n_y, c);
+      if (in_free)
+        ++run;
+      else
+        close_run();
     }
+    close_run();
   }
   for (const Opening& o : summary_x.openings()) {
     const Eigen::Vector2d a = T_y_x * o.a, b = T_y_x * o.b;
@@ -85,7 +112,8 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
       if (!NearWall(walls_y, p, c.door_wall_distance_m)) continue;
       solid += width / n;
     }
-    if (solid >= c.door_solid_share * width) out.openings_on_solid_m += solid;
+    if (solid >= c.door_solid_share * width && !SameDoorway(summary_y, a, b, c.door_wall_distance_m, c.max_opening_m))
+      out.openings_on_solid_m += solid;
   }
   return out;
 }

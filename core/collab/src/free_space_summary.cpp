@@ -118,7 +118,7 @@ Status FreeSpaceSummary::Build(const FreeSpaceGrid& grid, std::span<const Distil
       for (int fy = 0; fy < ratio && !occupied; ++fy) {
         for (int fx = 0; fx < ratio; ++fx) {
           const int gx = (cx0 + cx) * ratio + fx, gy = (cy0 + cy) * ratio + fy;
-          if (grid.ever_occupied(gx, gy)) {
+          if (grid.state(gx, gy) == FreeSpaceGrid::Cell::kOccupied) {
             occupied = true;
             break;
           }
@@ -150,11 +150,12 @@ void FreeSpaceSummary::FindOpenings(const FreeSpaceGrid& grid, const DistilledWa
   if (length < static_cast<double>(config_.min_opening_m)) return;
   auto clear_at = [&](const Eigen::Vector2d& p) {
     int x = 0, y = 0;
-    return grid.ToCell(p, x, y) && grid.clear_below_sensor(x, y) && !grid.ever_occupied(x, y);
+    return grid.ToCell(p, x, y) && grid.clear_below_sensor(x, y) &&
+           grid.state(x, y) != FreeSpaceGrid::Cell::kOccupied;
   };
   auto unhit_at = [&](const Eigen::Vector2d& p) {
     int x = 0, y = 0;
-    return grid.ToCell(p, x, y) && !grid.ever_occupied(x, y);
+    return grid.ToCell(p, x, y) && grid.state(x, y) != FreeSpaceGrid::Cell::kOccupied;
   };
   const auto steps = static_cast<int>(length / step);
   int run_start = -1, last_open = -2;

@@ -5,6 +5,7 @@ namespace msgraphs::core {
 namespace {
 
 bool Standing(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.refute_conflict_m; }
+bool StillStanding(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.undo_conflict_m; }
 
 bool Beats(const Hypothesis& leader, const Hypothesis& rival, double ratio, const MergeRuleConfig& c) {
   return leader.agreement.agreement_m >= ratio * rival.agreement.agreement_m + c.margin_m;
@@ -36,7 +37,7 @@ const char* ToString(MergeVerdict v) {
 
 Status MergeRuleConfig::Validate() const {
   if (!(min_agreement_m > 0) || !(min_constraint_m > 0) || !(accept_conflict_m >= 0) ||
-      !(refute_conflict_m >= accept_conflict_m) || !(min_rival_constraint_m > 0) || !(margin_ratio >= 1) ||
+      !(refute_conflict_m >= accept_conflict_m) || !(undo_conflict_m >= refute_conflict_m) || !(min_rival_constraint_m > 0) || !(margin_ratio >= 1) ||
       !(margin_m >= 0) || !(symmetric_margin_ratio >= margin_ratio)) {
     return Error{Errc::kInvalidConfig,
                  "merge rule: positive evidence thresholds, accept <= refute, margins >= 1 and ordered"};
@@ -71,7 +72,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
       Hypothesis& h = in.hypotheses[i];
       if (!SameTransform(h.T_a_b, *current, 2 * same_m, 2 * same_rad)) continue;
       MeasureConflict(h, in, cc);
-      if (Standing(h, c)) leader = static_cast<int>(i);
+      if (StillStanding(h, c)) leader = static_cast<int>(i);
     }
     if (leader >= 0) {
       L = in.hypotheses[static_cast<std::size_t>(leader)];
@@ -80,7 +81,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
       // No longer proposed (its walls changed): judged as it is.
       Hypothesis h = search.Evaluate(*in.walls_a, *in.walls_b, *current);
       MeasureConflict(h, in, cc);
-      if (Standing(h, c) && h.agreement.constraint_m >= c.min_rival_constraint_m) {
+      if (StillStanding(h, c) && h.agreement.constraint_m >= c.min_rival_constraint_m) {
         L = h;
         keeping = true;
       }
@@ -96,6 +97,8 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
   for (const Hypothesis& h : in.hypotheses) out.refuted += h.conflict_known && !Standing(h, c) ? 1u : 0u;
   if (leader < 0 && !keeping) {
     out.verdict = MergeVerdict::kRefuted;
+    out.best_refuted = in.hypotheses[0];
+    out.has_best_refuted = true;
     return out;
   }
   out.leader = L;

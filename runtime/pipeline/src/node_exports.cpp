@@ -16,6 +16,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "msgraphs/runtime/outputs/merge_log_csv.hpp"
 #include "msgraphs/runtime/outputs/pcd_file.hpp"
 #include "node_impl.hpp"
 
@@ -151,24 +152,9 @@ void Node::Impl::WriteExports() {
     fs::rename(temp, final_path, ec);
   };
   write("merge_log.csv", [&](std::ostream& out) {
-    out << "# robot " << config.robot.value
-        << "'s merge decisions: seconds since the node started, the peer, what changed, the rule's "
-           "verdict, the leading transform (peer's map in ours), its evidence (m), the strongest "
-           "standing rival's\n"
-           "sequence,time_s,peer,event,verdict,x,y,z,yaw_rad,agreement_m,constraint_m,conflict_m,"
-           "rival_agreement_m,rival_constraint_m,rival_conflict_m,rival_from_symmetry,symmetric,"
-           "hypotheses,refuted\n";
+    outputs::WriteMergeLogHeader(out, config.robot.value, "seconds since the node started");
     std::lock_guard<std::mutex> lock(session_mutex);
-    for (const core::MergeLogEntry& e : merge_log) {
-      const Eigen::Vector3d& t = e.T_self_peer.translation();
-      const Eigen::Vector3d x = e.T_self_peer.linear().col(0);
-      out << e.sequence << ',' << e.now_s << ',' << e.peer << ',' << core::ToString(e.event) << ",\""
-          << core::ToString(e.verdict) << "\"," << t.x() << ',' << t.y() << ',' << t.z() << ','
-          << std::atan2(x.y(), x.x()) << ',' << e.leader.agreement_m << ',' << e.leader.constraint_m << ','
-          << e.leader.conflict_m << ',' << e.rival.agreement_m << ',' << e.rival.constraint_m << ','
-          << e.rival.conflict_m << ',' << (e.rival_from_symmetry ? 1 : 0) << ',' << (e.symmetric ? 1 : 0)
-          << ',' << e.hypotheses << ',' << e.refuted << '\n';
-    }
+    outputs::WriteMergeLogRows(out, merge_log);
     if (merge_log_dropped > 0) out << "# " << merge_log_dropped << " later decisions not kept\n";
   });
   write("collab_graph.csv", [&](std::ostream& out) {

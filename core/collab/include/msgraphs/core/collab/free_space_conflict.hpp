@@ -6,10 +6,13 @@
 //   in the doorways between two pieces of one of y's walls that x's wall spans (a wall over a
 //   doorway is its lintel, seen by one robot and not the other), and within `extent_tolerance_m` of the wall's ends (an
 //   extent grows with every point associated to the plane and overshoots now and then; a wrong
-//   transform lays whole walls across free space, not their last half metre).
+//   transform lays whole walls across free space, not their last half metre); and only
+//   stretches of at least `min_stretch_m`.
 // - An opening on a solid wall: samples of x's openings that fall on cells y saw occupied next
 //   to one of y's walls, away from y's own openings; counted when they cover at least
-//   `door_solid_share` of the opening (a correct transform leaves the jambs, a fraction of it).
+//   `door_solid_share` of the opening (a correct transform leaves the jambs, a fraction of it,
+//   and a door y saw only edge-on may look closed in part), and when y saw no opening of its
+//   own on that line within `max_opening_m` (then both saw one door, its extent differently).
 // Both are lengths in metres; the merge rule compares them with its thresholds (merge_rule.hpp).
 // No allocation.
 #pragma once
@@ -31,7 +34,10 @@ struct FreeSpaceConflictConfig {
   double extent_tolerance_m = 0.5;
   /// An opening this close is the same opening; a wall sample this close to one is its lintel.
   double opening_margin_m = 0.3;
-  double door_solid_share = 0.6;
+  /// Stretches of a wall shorter than this in seen-through space do not count: a wrong transform
+  /// lays walls across free space, the maps' own noise a short stretch of one here and there.
+  double min_stretch_m = 1.0;
+  double door_solid_share = 0.8;
   double door_wall_distance_m = 0.3;  ///< an occupied cell this close to a wall line is that wall
   double max_opening_m = 3.0;         ///< the widest doorway (building codes: double doors 2.4 m)
   Status Validate() const;

@@ -6,14 +6,14 @@
 // A 2-D grid in the robot's map frame over the bounding box of what its free-space grid knows,
 // at `cell_m` (0.2 m: 2 x 2 cells of the 0.1 m grid; coarser cells swallow the end wall of a
 // narrow corridor in the conflict test's clearance), each cell unknown, free or occupied:
-// - occupied when any return ever fell in one of its fine cells (FreeSpaceGrid::ever_occupied:
-//   rays passing over a rack towards the ceiling do not clear it, and a person walking by only
-//   takes free space away, which can hide evidence but never invent it);
+// - occupied when one of its fine cells is (FreeSpaceGrid::state: returns there outweigh the
+//   rays through it; a few grazing returns off a door's jamb do not close the door);
 // - free when at least `min_free_share` of its fine cells are clear below the sensor (crossed by
-//   descending rays: no obstacle as tall as a wall can stand there) and none is occupied;
+//   descending rays: no obstacle as tall as a wall can stand there, whatever passed over a rack
+//   towards the ceiling) and none is occupied;
 // - unknown otherwise.
 // And the openings: where the robot saw through one of its own walls (a door, a wide opening),
-// from the fine grid: clear on both sides of the wall's line and no return across its body. A peer's wall
+// from the fine grid: clear on both sides of the wall's line and not occupied across its body. A peer's wall
 // across one of them is a lintel, not a conflict; a peer's opening on a wall seen solid here is.
 // After Build or Decode, every free cell carries its clearance (chamfer distance to the nearest
 // non-free cell), so that a conflict is only counted well inside what was seen (a wall one

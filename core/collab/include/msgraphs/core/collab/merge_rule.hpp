@@ -19,9 +19,10 @@
 //    robots share repeats and the difference in agreement may be nothing but which copy each
 //    robot saw more of: the margin becomes `symmetric_margin_ratio`, and the alternative is a
 //    rival too.
-// Then: merge with the leader. A merged pair is kept while its hypothesis is not refuted and no
-// rival beats it by the margin (hysteresis: accept at accept_conflict_m, undo beyond
-// refute_conflict_m).
+// Then: merge with the leader. A merged pair is kept while its hypothesis has at most
+// `undo_conflict_m` of conflict and no rival beats it by the margin (hysteresis: accept at
+// accept_conflict_m, refute others beyond refute_conflict_m, undo a merge beyond
+// undo_conflict_m).
 //
 // Why this does not merge wrongly (docs/multi-robot.md, "The merge rule"): a wrong transform
 // that wins must (a) contradict nothing either robot saw, (b) lay walls on walls in two
@@ -45,8 +46,11 @@ namespace msgraphs::core {
 struct MergeRuleConfig {
   double min_agreement_m = 8.0;
   double min_constraint_m = 3.0;
-  double accept_conflict_m = 0.4;
-  double refute_conflict_m = 0.8;
+  double accept_conflict_m = 0.25;
+  double refute_conflict_m = 0.5;
+  /// A merged transform is undone only beyond this much conflict (or a rival beating it): the
+  /// hysteresis that keeps one noisy exchange from flapping a merge.
+  double undo_conflict_m = 1.0;
   double min_rival_constraint_m = 1.0;
   double margin_ratio = 1.5;
   double margin_m = 3.0;
@@ -72,6 +76,9 @@ struct MergeDecision {
   MergeVerdict verdict = MergeVerdict::kNoHypothesis;
   Hypothesis leader, rival;         ///< rival: the strongest standing one (when there is one)
   bool has_leader = false, has_rival = false;
+  /// kRefuted: the best hypothesis by agreement, refuted (for the log: what contradicted it).
+  Hypothesis best_refuted;
+  bool has_best_refuted = false;
   bool rival_from_symmetry = false;  ///< the rival is a symmetry of one map composed with the leader
   bool symmetric = false;            ///< a symmetry alternative stands: the wider margin applied
   bool keeping = false;     ///< the leader is the current merge (hysteresis applied)
