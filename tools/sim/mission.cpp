@@ -50,15 +50,17 @@ class RobotWalk {
       : world_(world), grid_(grid), rooms_(rooms), config_(config), walker_(walker), rng_(rng) {}
 
   // Walks one visit of rooms_[k]; false when nothing could be planned (nothing moved).
+  // visit.points counts the points reached (the mission can end on the way).
   bool Do(std::size_t k, VisitKind kind, RoomExclusion avoid, Visit& visit) {
     const RoomInfo& room = rooms_[k];
     visit.room = world_.rooms[static_cast<std::size_t>(room.world_index)].id;
     visit.kind = kind;
     visit.start_s = walker_.now_s();
     visit.points = 0;
+    bool moved = false;
     switch (kind) {
       case VisitKind::kPeek:
-        visit.points = Peek(room, avoid);
+        moved = Peek(room, avoid, visit.points);
         break;
       case VisitKind::kPartial: {
         const Entrance* e = NearestEntrance(room.entrances, walker_.position());
@@ -72,7 +74,7 @@ class RobotWalk {
         for (int i = 0; i < count; ++i) {
           const auto& goal =
               near[static_cast<std::size_t>(rng_.Index(static_cast<int>(near.size())))];
-          visit.points += WalkTo(goal, avoid) ? 1 : 0;
+          moved = WalkTo(goal, avoid, visit.points) || moved;
         }
         break;
       }
@@ -80,27 +82,29 @@ class RobotWalk {
         const int count = std::clamp(
             static_cast<int>(std::lround(room.area_m2 / config_.full_m2_per_point)), 3, 6);
         for (const auto& goal : CoverPoints(room.free, count, walker_.position()))
-          visit.points += WalkTo(goal, avoid) ? 1 : 0;
+          moved = WalkTo(goal, avoid, visit.points) || moved;
         break;
       }
       case VisitKind::kStart:
         break;
     }
     visit.end_s = walker_.now_s();
-    return visit.points > 0;
+    return moved;
   }
 
  private:
-  bool WalkTo(const Eigen::Vector2d& goal, const RoomExclusion& avoid) {
+  // False when there is no path; `reached` counts the goal if the robot got there in time.
+  bool WalkTo(const Eigen::Vector2d& goal, const RoomExclusion& avoid, int& reached) {
     const auto path = grid_.Plan(walker_.position(), goal, config_.robot_radius_m, avoid);
     if (path.size() < 2) return false;
-    walker_.Follow(path);
+    if (walker_.Follow(path)) ++reached;
     return true;
   }
 
   // Stands in (or just outside) the doorway without entering, looks in, turning left and
-  // right, for a few seconds. Returns 1 when it got there, else 0.
-  int Peek(const RoomInfo& room, RoomExclusion avoid) {
+  // right, for a few seconds. False when no doorway could be reached; `reached` counts the
+  // stand point if the robot got there in time.
+  bool Peek(const RoomInfo& room, RoomExclusion avoid, int& reached) {
     avoid.b = avoid.a;
     avoid.a = room.world_index;  // never through the room it only looks into
     // Entrances nearest first: the first one with a stand point the robot can reach.
@@ -117,7 +121,8 @@ class RobotWalk {
         continue;
       const auto path = grid_.Plan(from, stand, config_.robot_radius_m, avoid);
       if (path.size() < 2) continue;
-      walker_.Follow(path);
+      if (!walker_.Follow(path)) return true;
+      ++reached;
       const double in = std::atan2(e->inward.y(), e->inward.x());
       const double look_s = rng_.Uniform(config_.peek_look_min_s, config_.peek_look_max_s);
       const double sweep =
@@ -127,9 +132,9 @@ class RobotWalk {
         walker_.TurnTo(yaw);
         walker_.Hold(0.25 * look_s);
       }
-      return 1;
+      return true;
     }
-    return 0;
+    return false;
   }
 
   const World& world_;

@@ -75,7 +75,7 @@ struct Visit {
   VisitKind kind = VisitKind::kFull;
   double start_s = 0;  ///< mission time: walking towards the room began
   double end_s = 0;    ///< mission time: the visit's last point reached (or looking in ended)
-  int points = 0;      ///< points walked to (peek: 1, the stand point)
+  int points = 0;      ///< points reached (peek: 1, the stand point; fewer if time ran out)
 };
 
 struct RobotPlan {
