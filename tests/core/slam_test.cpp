@@ -156,15 +156,23 @@ std::vector<Eigen::Vector3f> ScanAt(const Eigen::Isometry3d& T_world_base,
 }
 
 // The true path (base at 0.5 m) inside the room and odometry with 5 % scale error and yaw drift.
+// With `rock_deg`, the base rocks like a trotting legged robot's: pitch +-rock_deg alternating
+// from step to step and roll at two thirds of it (level at the start, as a robot stands).
 struct Walk {
   std::vector<Eigen::Isometry3d> truth, odometry;
-  Walk() {
+  explicit Walk(double rock_deg = 0.0) {
     Eigen::Isometry3d odo = Eigen::Isometry3d::Identity();
     for (int i = 0; i < 30; ++i) {
       const double a = 2 * std::numbers::pi * i / 15.0;
       Eigen::Isometry3d T =
           Pose(5 + 2.5 * std::cos(a), 4 + 2.0 * std::sin(a), a + std::numbers::pi / 2);
       T.translation().z() = 0.5;
+      if (i > 0 && rock_deg > 0) {
+        const double rock = rock_deg * std::numbers::pi / 180.0;
+        T.linear() = T.linear() *
+                     Eigen::AngleAxisd((i % 2 ? 1 : -1) * rock, Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(0.67 * rock * std::sin(0.9 * i), Eigen::Vector3d::UnitX());
+      }
       if (i == 0) {
         odo = T;
       } else {
@@ -241,13 +249,17 @@ TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
   EXPECT_TRUE(g.has_floor());
 }
 
-TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
+class Relocalisation : public ::testing::TestWithParam<double> {};
+
+TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
   // A node killed at step 11 of the walk and restarted at step 14: its odometry integration
   // begins again at identity, 2 m and 80 degrees of turning away from where the map stopped.
+  // With the base rocking (the parameter, degrees), neither the last keyframe's base nor the
+  // new one is level.
   const LocalMapperConfig config = SmallConfig(64, 256);
   LocalMapper mapper;
   ASSERT_TRUE(mapper.Init(config));
-  const Walk walk;
+  const Walk walk(GetParam());
   std::vector<float> times(20000, 0.1f);
   for (std::size_t i = 0; i <= 11; ++i) {
     const double t = 10.0 + static_cast<double>(i);
@@ -258,7 +270,8 @@ TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
   }
   const SGraph& g = mapper.graph();
   const std::uint32_t last = static_cast<std::uint32_t>(g.keyframe_slots() - 1);
-  const Eigen::Isometry3d T_map_odom = g.keyframe_pose(last) * mapper.keyframe_odometry(last).inverse();
+  const Eigen::Isometry3d T_map_odom =
+      g.keyframe_pose(last) * mapper.keyframe_odometry(last).inverse();
   // Where the node stopped, and where it would be had it kept its last step's motion three
   // more steps, times 1.5 (the caller's prediction over the downtime).
   RelocaliseSearch search;
@@ -296,6 +309,8 @@ TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
   EXPECT_EQ(empty.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search).error().code,
             Errc::kNotFound);
 }
+
+INSTANTIATE_TEST_SUITE_P(LocalMapper, Relocalisation, ::testing::Values(0.0, 1.0, 2.0, 3.0));
 
 TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {
   const LocalMapperConfig config = SmallConfig(32, 128);

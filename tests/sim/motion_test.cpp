@@ -190,6 +190,7 @@ TEST(SlipEvents, OdometryIsWrongExactlyWhereMissionTxtSays) {
   config.yaw_drift_deg_per_10m = 0.0;
   config.noise_xy_m = config.noise_yaw_rad = config.noise_z_m = config.noise_roll_pitch_rad = 0.0;
   config.drop_probability = 0.0;
+  config.slip.enabled = true;
   config.slip.per_100m_min = config.slip.per_100m_max = 10.0;
   RobotReport report;
   report.plan = &robot;
@@ -280,6 +281,7 @@ TEST(SlipEvents, OffMeansNoneAndLeavesTheOtherErrorsAlone) {
   const RobotClocks clocks = RobotClocks::Draw(9, 1);
   TempDir dir("slip_off");
   OdometrySimConfig on, off;
+  on.slip.enabled = true;
   on.slip.per_100m_min = on.slip.per_100m_max = 30.0;  // 15 m walked: a few events
   off.slip.enabled = false;
   OdometrySimStats s_on, s_off;

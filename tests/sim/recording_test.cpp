@@ -270,11 +270,13 @@ TEST(SimulatorDeterminism, SameSeedSameBytesOtherSeedOtherBytes) {
     mc.shared_rooms = 0;
     mc.people.count = 2;
     mc.start_delays.mode = StartDelays::Mode::kRandom;
+    mc.visit_kinds = VisitKinds::Benchmark();
     const Mission m = PlanMission(world, scene, mc, error).value();
     OutputConfig oc;
     oc.lidar.threads = threads;
     oc.world_path = world_path;
     oc.start_delays = "random";
+    oc.odometry.slip.enabled = true;
     EXPECT_TRUE(WriteMissionOutputs(world, scene, m, oc, dir.string(), error)) << error;
   };
   const fs::path base = fs::temp_directory_path() / ("msgraphs_det_" + std::to_string(getpid()));

@@ -20,9 +20,9 @@ namespace msgraphs::sim {
 
 struct PlanarPose;
 
-/// The ranges each robot's gait is drawn from (documented configuration values: Spot's trot as
-/// seen in its own state logs and videos: a few cm of bob, a few degrees of rocking, 1.5-2.5
-/// steps per second).
+/// The ranges each robot's gait is drawn from: documented configuration values, the benchmark's
+/// model of a trot (a few cm of bob, a few degrees of rocking, 1.5-2.5 steps per second), not
+/// measured on a real Spot.
 struct GaitConfig {
   bool enabled = true;
   double bob_min_m = 0.01, bob_max_m = 0.03;        ///< peak height oscillation

@@ -2,8 +2,9 @@
 // msgraphs_sim: renders a multi-robot mission through a world into the recordings a real robot
 // makes (VLP-16 pcap, CAN odometry candump log) plus ground truth. docs/simulator.md.
 //
-//   msgraphs_sim --world tools/sim/worlds/office.world --out runs/office --robots 3 --duration-s
-//   300 --seed 1 msgraphs_sim --world my.world --validate          # check a world file and stop
+//   msgraphs_sim --world tools/sim/worlds/office.world --out runs/office --robots 3
+//       --duration-s 300 --seed 1
+//   msgraphs_sim --world my.world --validate          # check a world file and stop
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -26,10 +27,13 @@ void Usage() {
       "usage: msgraphs_sim --world FILE (--out DIR | --validate | --svg FILE)\n"
       "         [--robots N (1..10, default 3)] [--duration-s S (default 300)] [--seed N]\n"
       "         [--threads N] [--pcap-ns] [--svg FILE] [--shared-rooms N (default 2)]\n"
-      "         [--visit-kinds peek=W,partial=W,full=W (default 0.3,0.3,0.4)]\n"
+      "         [--visit-kinds peek=W,partial=W,full=W (default full=1)]\n"
       "         [--start-delays none|random|R=S,... (default none)] [--people N (default 0)]\n"
-      "         [--truth-rate-hz R (10..1000, default 100)] [--slip on|off (default on)]\n"
-      "         [--gait on|off (default on)]\n");
+      "         [--truth-rate-hz R (10..1000, default 100)] [--slip on|off (default off)]\n"
+      "         [--gait on|off (default on)]\n"
+      "         [--benchmark: a benchmark mission's defaults (visit kinds\n"
+      "          peek=0.3,partial=0.3,full=0.4, slips on, random start delays); the other\n"
+      "          options, wherever they are, still apply]\n");
 }
 
 bool OnOff(const std::string& v, bool& out) {
@@ -46,6 +50,14 @@ int main(int argc, char** argv) {
   MissionConfig mission_config;
   OutputConfig output;
   output.lidar.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // A benchmark mission's defaults first: the other options override them.
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) != "--benchmark") continue;
+    mission_config.visit_kinds = VisitKinds::Benchmark();
+    mission_config.start_delays.mode = StartDelays::Mode::kRandom;
+    output.start_delays = "random";
+    output.odometry.slip.enabled = true;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
@@ -66,6 +78,8 @@ int main(int argc, char** argv) {
       svg_path = need();
     else if (a == "--validate")
       validate_only = true;
+    else if (a == "--benchmark")
+      continue;  // applied above
     else if (a == "--pcap-ns")
       output.lidar.nanosecond_pcap = true;
     else if (a == "--robots")

@@ -339,7 +339,11 @@ std::optional<Mission> PlanMission(const World& world,
     // and each pair must share them), two random rooms of any kind, then random rooms and kinds
     // until the mission ends.
     std::vector<std::pair<int, VisitKind>> visits;
-    for (int s : shared) visits.push_back({s, DrawKind(config.visit_kinds, false, rng)});
+    for (int s : shared) {
+      // Drawn all the same, so that the random stream does not depend on the shared kind.
+      const VisitKind drawn = DrawKind(config.visit_kinds, false, rng);
+      visits.push_back({s, config.shared_visit_partial ? VisitKind::kPartial : drawn});
+    }
     for (std::size_t i = visits.size(); i > 1; --i)
       std::swap(visits[i - 1], visits[static_cast<std::size_t>(rng.Index(static_cast<int>(i)))]);
     for (int k = 0; k < 2; ++k) {
@@ -415,9 +419,16 @@ std::optional<Mission> PlanMission(const World& world,
                                                  mission.robots[b].rooms_visited.end()))
         common += static_cast<int>(ra.count(r));
       if (common < config.shared_rooms) {
+        auto entered = [&](const RobotPlan& r) {
+          std::string list;
+          for (const auto& room : r.rooms_visited) list += " " + room;
+          return list;
+        };
         error = "robots " + std::to_string(a + 1) + " and " + std::to_string(b + 1) +
-                " share only " + std::to_string(common) +
-                " rooms (mission too short for this building?)";
+                " share only " + std::to_string(common) + " of the " +
+                std::to_string(config.shared_rooms) +
+                " rooms asked for (mission too short for this building?); they entered" +
+                entered(mission.robots[a]) + ";" + entered(mission.robots[b]);
         return std::nullopt;
       }
     }

@@ -26,9 +26,11 @@ const char* ToString(VisitKind kind);
 
 /// Relative weights of the kinds of the visits a robot makes after leaving its start room. The
 /// shared rooms are always entered: their kinds are drawn from partial and full only (full when
-/// both weigh 0).
+/// both weigh 0). By default every visit is full (the shipped missions the demo and the tests
+/// run); Benchmark() is the mix of the benchmark missions.
 struct VisitKinds {
-  double peek = 0.3, partial = 0.3, full = 0.4;
+  double peek = 0.0, partial = 0.0, full = 1.0;
+  static VisitKinds Benchmark() { return {0.3, 0.3, 0.4}; }
   /// Parses "peek=0.3,partial=0.3,full=0.4" (any subset; missing kinds weigh 0).
   static std::optional<VisitKinds> Parse(const std::string& text, std::string& error);
 };
@@ -53,6 +55,10 @@ struct MissionConfig {
   double robot_radius_m = 0.35;  ///< clearance kept from walls and clutter
   double base_height_m = 0.5;    ///< Spot's body above the floor while walking (mean)
   int shared_rooms = 2;  ///< rooms every robot enters (partial or full): each pair shares them
+  /// Shared rooms are entered with a partial visit (a point or two near the door), whatever the
+  /// kinds' weights: a full visit of a 40 m corridor takes a minute, and a short mission must
+  /// still reach every shared room. Off: their kinds are drawn like the others' (partial/full).
+  bool shared_visit_partial = true;
   VisitKinds visit_kinds;
   StartDelays start_delays;
   GaitConfig gait;
