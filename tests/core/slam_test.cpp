@@ -158,15 +158,23 @@ std::vector<Eigen::Vector3f> ScanAt(const Eigen::Isometry3d& T_world_base,
 }
 
 // The true path (base at 0.5 m) inside the room and odometry with 5 % scale error and yaw drift.
+// With `rock_deg`, the base rocks like a trotting legged robot's: pitch +-rock_deg alternating
+// from step to step and roll at two thirds of it (level at the start, as a robot stands).
 struct Walk {
   std::vector<Eigen::Isometry3d> truth, odometry;
-  explicit Walk(int steps = 30) {  // 15 a lap
+  explicit Walk(int steps = 30, double rock_deg = 0.0) {  // 15 a lap
     Eigen::Isometry3d odo = Eigen::Isometry3d::Identity();
     for (int i = 0; i < steps; ++i) {
       const double a = 2 * std::numbers::pi * i / 15.0;
       Eigen::Isometry3d T =
           Pose(5 + 2.5 * std::cos(a), 4 + 2.0 * std::sin(a), a + std::numbers::pi / 2);
       T.translation().z() = 0.5;
+      if (i > 0 && rock_deg > 0) {
+        const double rock = rock_deg * std::numbers::pi / 180.0;
+        T.linear() = T.linear() *
+                     Eigen::AngleAxisd((i % 2 ? 1 : -1) * rock, Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(0.67 * rock * std::sin(0.9 * i), Eigen::Vector3d::UnitX());
+      }
       if (i == 0) {
         odo = T;
       } else {
@@ -243,13 +251,17 @@ TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
   EXPECT_TRUE(g.has_floor());
 }
 
-TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
+class Relocalisation : public ::testing::TestWithParam<double> {};
+
+TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
   // A node killed at step 11 of the walk and restarted at step 14: its odometry integration
   // begins again at identity, 2 m and 80 degrees of turning away from where the map stopped.
+  // With the base rocking (the parameter, degrees), neither the last keyframe's base nor the
+  // new one is level.
   const LocalMapperConfig config = SmallConfig(64, 256);
   LocalMapper mapper;
   ASSERT_TRUE(mapper.Init(config));
-  const Walk walk;
+  const Walk walk(30, GetParam());
   std::vector<float> times(20000, 0.1f);
   for (std::size_t i = 0; i <= 11; ++i) {
     const double t = 10.0 + static_cast<double>(i);
@@ -299,6 +311,8 @@ TEST(LocalMapper, RelocalisesAfterTheOdometryRestartedWhileTheRobotMoved) {
   EXPECT_EQ(empty.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search).error().code,
             Errc::kNotFound);
 }
+
+INSTANTIATE_TEST_SUITE_P(LocalMapper, Relocalisation, ::testing::Values(0.0, 1.0, 2.0, 3.0));
 
 // Four laps of the room with a keyframe store for a third of them: loop closures every few
 // keyframes once the path is 10 m long, so that soon every keyframe the graph could sparsify

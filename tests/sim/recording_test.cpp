@@ -4,7 +4,6 @@
 // generated candump log reproduces the ground truth within the configured errors, and the
 // error statistics match the configuration; the same seed gives the same bytes.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,6 +18,7 @@
 #include "clocks.hpp"
 #include "lidar_sim.hpp"
 #include "mission.hpp"
+#include "mission_output.hpp"
 #include "msgraphs/drivers/can_odometry/candump_file.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/velodyne/data_packet_decoder.hpp"
@@ -48,14 +48,17 @@ struct Fixture {
     config.seed = seed;
     config.shared_rooms = 0;
     mission = PlanMission(world, *scene, config, error).value();
-    dir = fs::temp_directory_path() / ("msgraphs_sim_" + std::to_string(getpid()) + "_" + std::to_string(seed));
+    dir = fs::temp_directory_path() /
+          ("msgraphs_sim_" + std::to_string(getpid()) + "_" + std::to_string(seed));
     fs::create_directories(dir);
   }
   ~Fixture() { fs::remove_all(dir); }
 };
 
 double Percentile(std::vector<double> v, double q) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1)), v.end());
+  std::nth_element(v.begin(),
+                   v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1)),
+                   v.end());
   return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
@@ -69,8 +72,11 @@ TEST_P(LidarOnSurfaces, DecodedPointsLieOnTheWorldWithinTheNoiseModel) {
   LidarSimStats stats;
   std::string error;
   const std::string pcap = (f.dir / "velodyne.pcap").string();
-  ASSERT_TRUE(RenderLidar(*f.scene, robot.trajectory, config, clocks, 11, robot.id, pcap, stats, error)) << error;
-  EXPECT_GT(static_cast<double>(stats.returns) / static_cast<double>(stats.rays), 0.95) << "indoors nearly every ray returns";
+  ASSERT_TRUE(
+      RenderLidar(*f.scene, robot.trajectory, config, clocks, 11, robot.id, pcap, stats, error))
+      << error;
+  EXPECT_GT(static_cast<double>(stats.returns) / static_cast<double>(stats.rays), 0.95)
+      << "indoors nearly every ray returns";
 
   // Through the drivers, as a robot would: pcap -> UDP payloads -> decoder -> device clock.
   const auto capture = test::LoadCapture(pcap);
@@ -89,10 +95,12 @@ TEST_P(LidarOnSurfaces, DecodedPointsLieOnTheWorldWithinTheNoiseModel) {
     if (k % 7 != 0) continue;  // a sample of the packets keeps the test fast
     for (std::size_t i = 0; i < r->points; ++i) {
       const auto& p = out[i];
-      const double t = static_cast<double>(first.nanoseconds_since_epoch() - host0 + p.time_offset_ns) * 1e-9;
-      const Eigen::Vector3d world_point = robot.trajectory.Pose(t) * config.T_base_lidar *
-                                          Eigen::Vector3d(static_cast<double>(p.x_m), static_cast<double>(p.y_m),
-                                                          static_cast<double>(p.z_m));
+      const double t =
+          static_cast<double>(first.nanoseconds_since_epoch() - host0 + p.time_offset_ns) * 1e-9;
+      const Eigen::Vector3d world_point =
+          robot.trajectory.Pose(t) * config.T_base_lidar *
+          Eigen::Vector3d(static_cast<double>(p.x_m), static_cast<double>(p.y_m),
+                          static_cast<double>(p.z_m));
       residuals.push_back(f.scene->DistanceToSurface(world_point, 1.5));
     }
   }
@@ -109,11 +117,13 @@ TEST_P(LidarOnSurfaces, DecodedPointsLieOnTheWorldWithinTheNoiseModel) {
   RecordProperty("rms_m", std::to_string(rms));
 }
 
-INSTANTIATE_TEST_SUITE_P(Worlds, LidarOnSurfaces, ::testing::Values("office.world", "rotated.world"));
+INSTANTIATE_TEST_SUITE_P(Worlds,
+                         LidarOnSurfaces,
+                         ::testing::Values("office.world", "rotated.world"));
 
 // Integrates a candump log through OdometryStream; returns the poses (and the stream's stats).
-std::vector<drivers::can_odometry::OdometryPose> Integrate(const std::string& path,
-                                                           drivers::can_odometry::OdometryStreamStats& stats) {
+std::vector<drivers::can_odometry::OdometryPose> Integrate(
+    const std::string& path, drivers::can_odometry::OdometryStreamStats& stats) {
   namespace can = drivers::can_odometry;
   auto reader = can::CandumpFileReader::Open(path.c_str()).value();
   auto stream = can::OdometryStream::Create({}).value();
@@ -131,6 +141,8 @@ double Yaw(const drivers::can_odometry::Pose3& p) {
   return std::atan2(2.0 * (p.qw * p.qz + p.qx * p.qy), 1.0 - 2.0 * (p.qy * p.qy + p.qz * p.qz));
 }
 
+// With every error off (slips too), the candump log integrated by the drivers is the true
+// 6-DOF motion: the gait's height bob and roll and pitch rocking included.
 TEST(OdometryRecording, WithoutErrorsItReproducesTheGroundTruth) {
   Fixture f("apartment.world", 120.0, 21);
   const RobotPlan& robot = f.mission.robots[0];
@@ -139,25 +151,47 @@ TEST(OdometryRecording, WithoutErrorsItReproducesTheGroundTruth) {
   config.scale_error_min = config.scale_error_max = 0.0;
   config.yaw_drift_deg_per_10m = 0.0;
   config.noise_xy_m = config.noise_yaw_rad = 0.0;
+  config.noise_z_m = config.noise_roll_pitch_rad = 0.0;
   config.drop_probability = 0.0;
+  config.slip.enabled = false;
   OdometrySimStats stats;
   std::string error;
   const std::string log = (f.dir / "odometry.log").string();
-  ASSERT_TRUE(RenderOdometry(robot.trajectory, config, clocks, 21, robot.id, log, stats, error)) << error;
+  ASSERT_TRUE(RenderOdometry(robot.trajectory, config, clocks, 21, robot.id, log, stats, error))
+      << error;
+  EXPECT_TRUE(stats.slips.empty());
   drivers::can_odometry::OdometryStreamStats s;
   const auto poses = Integrate(log, s);
   ASSERT_EQ(poses.size(), stats.samples);
   EXPECT_EQ(s.crc_errors + s.bad_frames + s.foreign_ids, 0u);
   // Odometry starts at the identity at the first sample (t = 0.02 s): compare in that frame.
   const Eigen::Isometry3d T0 = robot.trajectory.Pose(0.02);
-  double worst = 0;
+  double worst_xy = 0, worst_z = 0, worst_rotation = 0, max_tilt = 0, z_lo = 1e9, z_hi = -1e9;
   for (const auto& p : poses) {
     const double t = (p.stamp - clocks.Host(0.0)).seconds();
     const Eigen::Isometry3d truth = T0.inverse() * robot.trajectory.Pose(t);
-    worst = std::max(worst, std::hypot(p.T_odom_base.x_m - truth.translation().x(), p.T_odom_base.y_m - truth.translation().y()));
+    const auto& o = p.T_odom_base;
+    worst_xy = std::max(
+        worst_xy, std::hypot(o.x_m - truth.translation().x(), o.y_m - truth.translation().y()));
+    worst_z = std::max(worst_z, std::fabs(o.z_m - truth.translation().z()));
+    const Eigen::Quaterniond q(o.qw, o.qx, o.qy, o.qz);
+    worst_rotation =
+        std::max(worst_rotation,
+                 Eigen::AngleAxisd(q.toRotationMatrix().transpose() * truth.linear()).angle());
+    const Eigen::Matrix3d R_world = robot.trajectory.Pose(t).linear();
+    max_tilt = std::max(max_tilt, std::acos(std::clamp(R_world(2, 2), -1.0, 1.0)));
+    z_lo = std::min(z_lo, truth.translation().z());
+    z_hi = std::max(z_hi, truth.translation().z());
   }
-  // Only the DBC's quantisation (0.1 mm, 1e-5 rad per sample) separates them.
-  EXPECT_LT(worst, 0.05) << "over " << stats.path_length_m << " m";
+  // The motion is not planar: the base tilts by degrees and bobs by centimetres...
+  EXPECT_GT(max_tilt, 1.0 * std::numbers::pi / 180.0);
+  EXPECT_GT(z_hi - z_lo, 0.015);
+  // ... and only the DBC's quantisation (0.1 mm, 1e-5 rad per sample) separates the two.
+  EXPECT_LT(worst_xy, 0.05) << "over " << stats.path_length_m << " m";
+  EXPECT_LT(worst_z, 0.01);
+  EXPECT_LT(worst_rotation, 0.002);
+  RecordProperty("worst_xy_m", std::to_string(worst_xy));
+  RecordProperty("worst_rotation_rad", std::to_string(worst_rotation));
 }
 
 TEST(OdometryRecording, ErrorStatisticsMatchTheConfiguration) {
@@ -166,10 +200,12 @@ TEST(OdometryRecording, ErrorStatisticsMatchTheConfiguration) {
   const RobotClocks clocks = RobotClocks::Draw(5, robot.id);
   OdometrySimConfig config;
   config.drop_probability = 0.005;
+  config.slip.enabled = false;  // slips have their own test (slip_test.cpp)
   OdometrySimStats stats;
   std::string error;
   const std::string log = (f.dir / "odometry.log").string();
-  ASSERT_TRUE(RenderOdometry(robot.trajectory, config, clocks, 5, robot.id, log, stats, error)) << error;
+  ASSERT_TRUE(RenderOdometry(robot.trajectory, config, clocks, 5, robot.id, log, stats, error))
+      << error;
   EXPECT_GE(std::fabs(stats.scale_error), 0.01);
   EXPECT_LE(std::fabs(stats.scale_error), 0.02);
   drivers::can_odometry::OdometryStreamStats s;
@@ -186,7 +222,8 @@ TEST(OdometryRecording, ErrorStatisticsMatchTheConfiguration) {
     const auto& a = poses[i].T_odom_base;
     const auto& b = poses[i + 50].T_odom_base;
     const PlanarPose ta = robot.trajectory.Planar(poses[i].stamp.seconds_since_epoch() - t_host0);
-    const PlanarPose tb = robot.trajectory.Planar(poses[i + 50].stamp.seconds_since_epoch() - t_host0);
+    const PlanarPose tb =
+        robot.trajectory.Planar(poses[i + 50].stamp.seconds_since_epoch() - t_host0);
     const double true_chord = std::hypot(tb.x - ta.x, tb.y - ta.y);
     if (true_chord < 0.5) continue;
     true_chords += true_chord;
@@ -195,13 +232,15 @@ TEST(OdometryRecording, ErrorStatisticsMatchTheConfiguration) {
   ASSERT_GT(true_chords, 50.0);
   EXPECT_NEAR(odom_chords / true_chords - 1.0, stats.scale_error, 0.002);
   RecordProperty("measured_scale_error", std::to_string(odom_chords / true_chords - 1.0));
-  const double true_length = robot.trajectory.PathLength(poses.back().stamp.seconds_since_epoch() - t_host0);
+  const double true_length =
+      robot.trajectory.PathLength(poses.back().stamp.seconds_since_epoch() - t_host0);
   // Yaw drift: heading error per metre travelled, against the configured rate.
   const Eigen::Isometry3d T0 = robot.trajectory.Pose(0.02);
   const double t_end = (poses.back().stamp - clocks.Host(0.0)).seconds();
   const Eigen::Isometry3d truth_end = T0.inverse() * robot.trajectory.Pose(t_end);
   const double true_yaw = std::atan2(truth_end.linear()(1, 0), truth_end.linear()(0, 0));
-  const double yaw_error = std::remainder(Yaw(poses.back().T_odom_base) - true_yaw, 2 * std::numbers::pi);
+  const double yaw_error =
+      std::remainder(Yaw(poses.back().T_odom_base) - true_yaw, 2 * std::numbers::pi);
   const double rate = yaw_error / true_length;
   EXPECT_NEAR(rate, stats.yaw_drift_rad_per_m, 0.2 * std::fabs(stats.yaw_drift_rad_per_m))
       << "measured " << rate * 10 * 180 / std::numbers::pi << " deg/10 m, configured "
@@ -216,33 +255,46 @@ std::string Slurp(const fs::path& p) {
   return s.str();
 }
 
+// Every output file of a mission (people, start delays, slips and gait on) is the same byte
+// for byte whatever the thread count; another seed changes the recordings.
 TEST(SimulatorDeterminism, SameSeedSameBytesOtherSeedOtherBytes) {
-  auto render = [](std::uint64_t seed, int threads, const fs::path& dir) {
+  const std::string world_path = std::string(MSGRAPHS_WORLDS_DIR) + "/office.world";
+  auto render = [&](std::uint64_t seed, int threads, const fs::path& dir) {
     std::string error;
-    const World world = LoadWorld(std::string(MSGRAPHS_WORLDS_DIR) + "/office.world", error).value();
+    const World world = LoadWorld(world_path, error).value();
     const Scene scene(world, 0);
     MissionConfig mc;
     mc.robots = 2;
-    mc.duration_s = 4;
+    mc.duration_s = 6;
     mc.seed = seed;
     mc.shared_rooms = 0;
+    mc.people.count = 2;
+    mc.start_delays.mode = StartDelays::Mode::kRandom;
+    mc.visit_kinds = VisitKinds::Benchmark();
     const Mission m = PlanMission(world, scene, mc, error).value();
-    fs::create_directories(dir);
-    LidarSimConfig lc;
-    lc.threads = threads;
-    LidarSimStats ls;
-    OdometrySimStats os;
-    const RobotClocks clocks = RobotClocks::Draw(seed, 2);
-    EXPECT_TRUE(RenderLidar(scene, m.robots[1].trajectory, lc, clocks, seed, 2, (dir / "v.pcap").string(), ls, error));
-    EXPECT_TRUE(RenderOdometry(m.robots[1].trajectory, {}, clocks, seed, 2, (dir / "o.log").string(), os, error));
+    OutputConfig oc;
+    oc.lidar.threads = threads;
+    oc.world_path = world_path;
+    oc.start_delays = "random";
+    oc.odometry.slip.enabled = true;
+    EXPECT_TRUE(WriteMissionOutputs(world, scene, m, oc, dir.string(), error)) << error;
   };
   const fs::path base = fs::temp_directory_path() / ("msgraphs_det_" + std::to_string(getpid()));
   render(1, 1, base / "a");
   render(1, 2, base / "b");  // thread count must not matter
   render(2, 2, base / "c");
-  EXPECT_EQ(Slurp(base / "a" / "v.pcap"), Slurp(base / "b" / "v.pcap"));
-  EXPECT_EQ(Slurp(base / "a" / "o.log"), Slurp(base / "b" / "o.log"));
-  EXPECT_NE(Slurp(base / "a" / "v.pcap"), Slurp(base / "c" / "v.pcap"));
+  std::size_t files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(base / "a")) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path rel = fs::relative(entry.path(), base / "a");
+    EXPECT_EQ(Slurp(entry.path()), Slurp(base / "b" / rel)) << rel;
+    ++files;
+  }
+  EXPECT_EQ(files, 16u);  // mission.txt, world, svg; 5 truth files; 4 per robot
+  EXPECT_NE(Slurp(base / "a" / "robot1" / "velodyne.pcap"),
+            Slurp(base / "c" / "robot1" / "velodyne.pcap"));
+  EXPECT_NE(Slurp(base / "a" / "robot2" / "odometry.log"),
+            Slurp(base / "c" / "robot2" / "odometry.log"));
   fs::remove_all(base);
 }
 

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The clocks of one simulated robot. Everything is simulated on one timeline t (seconds from
-// the mission start); each device sees it through its own clock, as on a real robot:
-//   host (UNIX, what pcap and candump stamp): unix_offset_s + t; every robot has its own offset,
+// The clocks of one simulated robot. Every device sees the mission's timeline through its own
+// clock, as on a real robot. The functions take the robot's own time t (seconds since the
+// robot started, which is start_delay_s into the mission):
+//   host (UNIX, what pcap and candump stamp): unix_offset_s + start_delay_s + t, i.e.
+//     unix_offset_s is the robot's clock at mission time 0; every robot has its own offset,
 //     so robots' clocks are not synchronised (spec section 5);
 //   lidar (microseconds past the hour, free-running indoors without GPS): its own phase and drift;
 //   CAN bridge (microseconds, wraps at 2^32): its own start.
@@ -17,9 +19,10 @@ namespace msgraphs::sim {
 
 struct RobotClocks {
   double unix_offset_s = 1.7e9;
-  double lidar_phase_us = 0.0;   ///< lidar clock at t = 0, past the hour
+  double lidar_phase_us = 0.0;  ///< lidar clock at t = 0, past the hour
   double lidar_drift_ppm = 0.0;
   double bridge_start_us = 0.0;  ///< bridge clock at t = 0
+  double start_delay_s = 0.0;    ///< mission time at which the robot starts (its t = 0)
 
   static RobotClocks Draw(std::uint64_t seed, int robot) {
     Random r = Random::Stream(seed, 0x636C6F63, static_cast<std::uint64_t>(robot));  // "cloc"
@@ -33,7 +36,9 @@ struct RobotClocks {
   }
 
   UnixTime Host(double t) const {
-    return UnixTime::FromNanoseconds(static_cast<std::int64_t>(std::llround(unix_offset_s * 1e6)) * 1000 +
+    return UnixTime::FromNanoseconds(static_cast<std::int64_t>(std::llround(unix_offset_s * 1e6)) *
+                                         1000 +
+                                     static_cast<std::int64_t>(std::llround(start_delay_s * 1e9)) +
                                      static_cast<std::int64_t>(std::llround(t * 1e9)));
   }
   std::uint32_t LidarTimeOfHourUs(double t) const {
@@ -41,7 +46,8 @@ struct RobotClocks {
     return static_cast<std::uint32_t>(std::fmod(std::floor(us), 3.6e9));
   }
   std::uint32_t BridgeUs(double t) const {
-    return static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(bridge_start_us + t * 1e6)) & 0xFFFFFFFFu);
+    return static_cast<std::uint32_t>(
+        static_cast<std::uint64_t>(std::llround(bridge_start_us + t * 1e6)) & 0xFFFFFFFFu);
   }
 };
 

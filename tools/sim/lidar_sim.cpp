@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -28,25 +29,40 @@ struct Chunk {
   std::vector<Packet> packets;
   std::vector<double> first_firing_t;
   LidarSimStats stats;
+  WallVisibility visibility;  // this chunk's wall hits (summed in any order: deterministic)
 };
 
-void RenderChunk(const Scene& scene, const Trajectory& trajectory, const LidarSimConfig& config,
-                 const RobotClocks& clocks, std::uint64_t seed, int robot, std::int64_t first_packet,
-                 std::int64_t count, double azimuth_phase_deg, Chunk& chunk) {
+void RenderChunk(const Scene& scene,
+                 const Trajectory& trajectory,
+                 const LidarSimConfig& config,
+                 const RobotClocks& clocks,
+                 std::uint64_t seed,
+                 int robot,
+                 std::int64_t first_packet,
+                 std::int64_t count,
+                 double azimuth_phase_deg,
+                 const PeopleScene* people,
+                 bool record_visibility,
+                 Chunk& chunk) {
   const vel::ModelInfo& model = vel::GetModelInfo(vel::SensorModel::kVlp16);
   Random rng = Random::Stream(seed, 0x6C696461 + static_cast<std::uint64_t>(robot),  // "lida"
                               static_cast<std::uint64_t>(first_packet));
   Scene::Scratch scratch = scene.MakeScratch();
   std::array<double, 16> cos_el{}, sin_el{}, offset{};
   for (int l = 0; l < 16; ++l) {
-    cos_el[static_cast<std::size_t>(l)] = std::cos(model.laser[static_cast<std::size_t>(l)].elevation_rad);
-    sin_el[static_cast<std::size_t>(l)] = std::sin(model.laser[static_cast<std::size_t>(l)].elevation_rad);
-    offset[static_cast<std::size_t>(l)] = model.laser[static_cast<std::size_t>(l)].vertical_offset_m;
+    cos_el[static_cast<std::size_t>(l)] =
+        std::cos(model.laser[static_cast<std::size_t>(l)].elevation_rad);
+    sin_el[static_cast<std::size_t>(l)] =
+        std::sin(model.laser[static_cast<std::size_t>(l)].elevation_rad);
+    offset[static_cast<std::size_t>(l)] =
+        model.laser[static_cast<std::size_t>(l)].vertical_offset_m;
   }
   const double deg_per_s = config.rpm * 6.0;
   const double cos_grazing = std::cos(config.grazing_dropout_deg * std::numbers::pi / 180.0);
   chunk.packets.resize(static_cast<std::size_t>(count));
   chunk.first_firing_t.resize(static_cast<std::size_t>(count));
+  const std::size_t n_people = people != nullptr ? people->size() : 0;
+  std::vector<Eigen::Vector2d> person_xy(n_people), person_v(n_people);
   for (std::int64_t k = 0; k < count; ++k) {
     const double t_packet = static_cast<double>(first_packet + k) * kPacketS;
     Packet& p = chunk.packets[static_cast<std::size_t>(k)];
@@ -58,23 +74,35 @@ void RenderChunk(const Scene& scene, const Trajectory& trajectory, const LidarSi
       block[1] = 0xEE;
       const double t_block = t_packet + 2 * b * kSequenceS;
       const double az_block = std::fmod(azimuth_phase_deg + deg_per_s * t_block, 360.0);
-      vel::WriteU16Le(block + 2, static_cast<std::uint16_t>(static_cast<int>(std::lround(az_block * 100.0)) % 36000));
+      vel::WriteU16Le(block + 2, static_cast<std::uint16_t>(
+                                     static_cast<int>(std::lround(az_block * 100.0)) % 36000));
       for (int s = 0; s < 2; ++s) {
         const double t_fire = t_block + s * kSequenceS;
         const Eigen::Isometry3d T_world_lidar = trajectory.Pose(t_fire) * config.T_base_lidar;
         const Eigen::Matrix3d& R = T_world_lidar.linear();
+        if (n_people > 0)
+          people->Snapshot(trajectory.start_s() + t_fire, person_xy.data(), person_v.data());
         for (int l = 0; l < 16; ++l) {
           const auto li = static_cast<std::size_t>(l);
           const double t_laser = t_fire + l * kLaserS;
           const double az = (azimuth_phase_deg + deg_per_s * t_laser) * std::numbers::pi / 180.0;
           // The ROS lidar frame: x towards azimuth 0, y left, azimuth clockwise from above.
-          const Eigen::Vector3d dir_lidar(cos_el[li] * std::cos(az), -cos_el[li] * std::sin(az), sin_el[li]);
+          const Eigen::Vector3d dir_lidar(cos_el[li] * std::cos(az), -cos_el[li] * std::sin(az),
+                                          sin_el[li]);
           const Eigen::Vector3d origin = T_world_lidar * Eigen::Vector3d(0, 0, offset[li]);
           const Eigen::Vector3d dir = R * dir_lidar;
           ++chunk.stats.rays;
           std::uint16_t units = 0;
           std::uint8_t reflectivity = 0;
-          if (auto hit = scene.Cast(origin, dir, config.max_range_m, scratch)) {
+          std::optional<Hit> hit = scene.Cast(origin, dir, config.max_range_m, scratch);
+          if (n_people > 0) {
+            Hit nearest =
+                hit ? *hit : Hit{config.max_range_m, {0, 0, 1}, Material::kPainted, -1, 0, -1};
+            if (people->Cast(person_xy.data(), person_v.data(), t_laser - t_fire, origin, dir,
+                             nearest))
+              hit = nearest;
+          }
+          if (hit) {
             const double cos_incidence = -hit->normal.dot(dir);
             if (cos_incidence < cos_grazing || rng.Chance(config.dropout_probability)) {
               ++chunk.stats.dropouts;
@@ -83,9 +111,15 @@ void RenderChunk(const Scene& scene, const Trajectory& trajectory, const LidarSi
               const double u = std::round(range / vel::kDistanceUnitM);
               if (range > 0.0 && range <= config.max_range_m && u >= 1.0 && u <= 65535.0) {
                 units = static_cast<std::uint16_t>(u);
-                const double r = Reflectivity(hit->material) * (0.35 + 0.65 * cos_incidence) + rng.Normal(2.0);
+                const double r =
+                    Reflectivity(hit->material) * (0.35 + 0.65 * cos_incidence) + rng.Normal(2.0);
                 reflectivity = static_cast<std::uint8_t>(std::clamp(std::lround(r), 1L, 255L));
                 ++chunk.stats.returns;
+                if (hit->person >= 0) ++chunk.stats.person_returns;
+                if (hit->wall >= 0 && hit->face != 0) {
+                  ++chunk.stats.wall_returns;
+                  if (record_visibility) chunk.visibility.Record(*hit, origin + dir * hit->range_m);
+                }
               }
             }
           }
@@ -113,9 +147,17 @@ std::array<std::uint8_t, vel::kPositionPacketBytes> PositionPacket(std::uint32_t
 
 }  // namespace
 
-bool RenderLidar(const Scene& scene, const Trajectory& trajectory, const LidarSimConfig& config,
-                 const RobotClocks& clocks, std::uint64_t seed, int robot, const std::string& pcap_path,
-                 LidarSimStats& stats, std::string& error) {
+bool RenderLidar(const Scene& scene,
+                 const Trajectory& trajectory,
+                 const LidarSimConfig& config,
+                 const RobotClocks& clocks,
+                 std::uint64_t seed,
+                 int robot,
+                 const std::string& pcap_path,
+                 LidarSimStats& stats,
+                 std::string& error,
+                 const PeopleScene* people,
+                 WallVisibility* visibility) {
   namespace pcap = msgraphs::drivers::pcap;
   auto writer = pcap::PcapFileWriter::Create(
       pcap_path.c_str(), config.nanosecond_pcap ? pcap::TimestampPrecision::kNanoseconds
@@ -144,9 +186,14 @@ bool RenderLidar(const Scene& scene, const Trajectory& trajectory, const LidarSi
       const std::int64_t count = std::min<std::int64_t>(kChunkPackets, total - start);
       ++used;
       workers.emplace_back([&, w, start, count] {
-        chunks[static_cast<std::size_t>(w)] = Chunk{};
+        Chunk& c = chunks[static_cast<std::size_t>(w)];
+        c.stats = {};
+        if (visibility != nullptr) {
+          if (c.visibility.walls() == 0) c.visibility = *visibility;
+          c.visibility.Clear();
+        }
         RenderChunk(scene, trajectory, config, clocks, seed, robot, start, count, azimuth_phase_deg,
-                    chunks[static_cast<std::size_t>(w)]);
+                    people, visibility != nullptr, c);
       });
     }
     for (auto& t : workers) t.join();
@@ -154,11 +201,14 @@ bool RenderLidar(const Scene& scene, const Trajectory& trajectory, const LidarSi
     for (int w = 0; w < used; ++w) {
       Chunk& c = chunks[static_cast<std::size_t>(w)];
       for (std::size_t k = 0; k < c.packets.size(); ++k) {
-        const double t_done = c.first_firing_t[k] + kPacketS;  // the packet leaves after its last firing
+        const double t_done =
+            c.first_firing_t[k] + kPacketS;  // the packet leaves after its last firing
         while (next_position_t <= t_done) {
           const auto pos = PositionPacket(clocks.LidarTimeOfHourUs(next_position_t));
           const double latency = 150e-6 + std::fabs(rng.Normal(40e-6));
-          if (Status s = writer->WriteUdp(clocks.Host(next_position_t + latency), sensor_position, broadcast_position, pos); !s) {
+          if (Status s = writer->WriteUdp(clocks.Host(next_position_t + latency), sensor_position,
+                                          broadcast_position, pos);
+              !s) {
             error = pcap_path + ": " + s.error().detail;
             return false;
           }
@@ -166,7 +216,9 @@ bool RenderLidar(const Scene& scene, const Trajectory& trajectory, const LidarSi
           next_position_t += config.position_packet_period_s;
         }
         const double latency = 120e-6 + std::fabs(rng.Normal(30e-6));
-        if (Status s = writer->WriteUdp(clocks.Host(t_done + latency), sensor, broadcast, c.packets[k]); !s) {
+        if (Status s =
+                writer->WriteUdp(clocks.Host(t_done + latency), sensor, broadcast, c.packets[k]);
+            !s) {
           error = pcap_path + ": " + s.error().detail;
           return false;
         }
@@ -175,6 +227,9 @@ bool RenderLidar(const Scene& scene, const Trajectory& trajectory, const LidarSi
       stats.rays += c.stats.rays;
       stats.returns += c.stats.returns;
       stats.dropouts += c.stats.dropouts;
+      stats.person_returns += c.stats.person_returns;
+      stats.wall_returns += c.stats.wall_returns;
+      if (visibility != nullptr) visibility->Merge(c.visibility);
     }
   }
   if (Status s = writer->Close(); !s) {

@@ -13,8 +13,10 @@
 #include <string>
 
 #include "clocks.hpp"
+#include "people.hpp"
 #include "scene.hpp"
 #include "trajectory.hpp"
+#include "visibility.hpp"
 
 namespace msgraphs::sim {
 
@@ -36,11 +38,23 @@ struct LidarSimStats {
   std::uint64_t rays = 0;
   std::uint64_t returns = 0;
   std::uint64_t dropouts = 0;
+  std::uint64_t person_returns = 0;  ///< returns from people
+  std::uint64_t wall_returns = 0;    ///< returns from wall faces (counted in the visibility)
 };
 
-/// Renders the whole trajectory into `pcap_path`. Returns false with `error` on I/O failure.
-bool RenderLidar(const Scene& scene, const Trajectory& trajectory, const LidarSimConfig& config,
-                 const RobotClocks& clocks, std::uint64_t seed, int robot, const std::string& pcap_path,
-                 LidarSimStats& stats, std::string& error);
+/// Renders the whole trajectory into `pcap_path`. `people` (optional) move in mission time
+/// (trajectory.start_s() + t); `visibility` (optional) receives every wall-face return. Returns
+/// false with `error` on I/O failure. The bytes do not depend on config.threads.
+bool RenderLidar(const Scene& scene,
+                 const Trajectory& trajectory,
+                 const LidarSimConfig& config,
+                 const RobotClocks& clocks,
+                 std::uint64_t seed,
+                 int robot,
+                 const std::string& pcap_path,
+                 LidarSimStats& stats,
+                 std::string& error,
+                 const PeopleScene* people = nullptr,
+                 WallVisibility* visibility = nullptr);
 
 }  // namespace msgraphs::sim

@@ -2,7 +2,8 @@
 // msgraphs_sim: renders a multi-robot mission through a world into the recordings a real robot
 // makes (VLP-16 pcap, CAN odometry candump log) plus ground truth. docs/simulator.md.
 //
-//   msgraphs_sim --world tools/sim/worlds/office.world --out runs/office --robots 3 --duration-s 300 --seed 1
+//   msgraphs_sim --world tools/sim/worlds/office.world --out runs/office --robots 3
+//       --duration-s 300 --seed 1
 //   msgraphs_sim --world my.world --validate          # check a world file and stop
 //   msgraphs_sim --building 7 --out runs/b7           # a generated building (building/generate.hpp)
 #include <chrono>
@@ -16,9 +17,8 @@
 
 #include "building/generate.hpp"
 
-#include "lidar_sim.hpp"
 #include "mission.hpp"
-#include "odometry_sim.hpp"
+#include "mission_output.hpp"
 #include "scene.hpp"
 #include "truth.hpp"
 #include "world.hpp"
@@ -29,15 +29,30 @@ namespace {
 using namespace msgraphs::sim;
 
 void Usage() {
-  std::fprintf(stderr,
-               "usage: msgraphs_sim (--world FILE | --building SEED [building options]) (--out DIR | --validate | --svg FILE)\n"
-               "                    [--robots N (2..10, default 3)] [--duration-s S (default 300)] [--seed N]\n"
-               "                    [--threads N] [--pcap-ns] [--svg FILE] [--shared-rooms N (default 2)]\n"
-               "       msgraphs_sim --building SEED [building options] --world-out FILE [--svg FILE]\n"
-               "building options: --style office|hospital|warehouse|construction|apartment|multi-wing\n"
-               "                  --corridor straight|L|T|U|loop  --symmetry none|identical-row|mirrored-wings|both\n"
-               "                  --clutter none|sparse|medium|dense  --rotation-deg D  --wing-angle-deg 0|30|45|60|90\n"
-               "                  --ceiling-m H (2.3..6)\n");
+  std::fprintf(
+      stderr,
+      "usage: msgraphs_sim (--world FILE | --building SEED [building options])\n"
+      "                    (--out DIR | --validate | --svg FILE)\n"
+      "         [--robots N (1..10, default 3)] [--duration-s S (default 300)] [--seed N]\n"
+      "         [--threads N] [--pcap-ns] [--svg FILE] [--shared-rooms N (default 2)]\n"
+      "         [--visit-kinds peek=W,partial=W,full=W (default full=1)]\n"
+      "         [--start-delays none|random|R=S,... (default none)] [--people N (default 0)]\n"
+      "         [--truth-rate-hz R (10..1000, default 100)] [--slip on|off (default off)]\n"
+      "         [--gait on|off (default on)]\n"
+      "         [--benchmark: a benchmark mission's defaults (visit kinds\n"
+      "          peek=0.3,partial=0.3,full=0.4, slips on, random start delays); the other\n"
+      "          options, wherever they are, still apply]\n"
+      "       msgraphs_sim --building SEED [building options] --world-out FILE [--svg FILE]\n"
+      "building options: --style office|hospital|warehouse|construction|apartment|multi-wing\n"
+      "         --corridor straight|L|T|U|loop  --symmetry none|identical-row|mirrored-wings|both\n"
+      "         --clutter none|sparse|medium|dense  --rotation-deg D\n"
+      "         --wing-angle-deg 0|30|45|60|90  --ceiling-m H (2.3..6)\n");
+}
+
+bool OnOff(const std::string& v, bool& out) {
+  if (v != "on" && v != "off") return false;
+  out = v == "on";
+  return true;
 }
 
 }  // namespace
@@ -46,9 +61,18 @@ int main(int argc, char** argv) {
   std::string world_path, out_dir, svg_path, world_out, error;
   std::optional<std::uint64_t> building_seed;
   msgraphs::sim::building::BuildingOptions building_options;
-  bool validate_only = false, pcap_ns = false;
+  bool validate_only = false;
   MissionConfig mission_config;
-  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  OutputConfig output;
+  output.lidar.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // A benchmark mission's defaults first: the other options override them.
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) != "--benchmark") continue;
+    mission_config.visit_kinds = VisitKinds::Benchmark();
+    mission_config.start_delays.mode = StartDelays::Mode::kRandom;
+    output.start_delays = "random";
+    output.odometry.slip.enabled = true;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
@@ -60,32 +84,66 @@ int main(int argc, char** argv) {
       ++i;
       return v;
     };
-    if (a == "--world") world_path = need();
-    else if (a == "--out") out_dir = need();
-    else if (a == "--svg") svg_path = need();
-    else if (a == "--validate") validate_only = true;
-    else if (a == "--pcap-ns") pcap_ns = true;
-    else if (a == "--robots") mission_config.robots = std::atoi(need());
-    else if (a == "--duration-s") mission_config.duration_s = std::atof(need());
-    else if (a == "--seed") mission_config.seed = std::strtoull(need(), nullptr, 10);
-    else if (a == "--threads") threads = std::max(1, std::atoi(need()));
-    else if (a == "--shared-rooms") mission_config.shared_rooms = std::atoi(need());
+    bool ok = true;
+    if (a == "--world")
+      world_path = need();
+    else if (a == "--out")
+      out_dir = need();
+    else if (a == "--svg")
+      svg_path = need();
+    else if (a == "--validate")
+      validate_only = true;
+    else if (a == "--benchmark")
+      continue;  // applied above
+    else if (a == "--pcap-ns")
+      output.lidar.nanosecond_pcap = true;
+    else if (a == "--robots")
+      mission_config.robots = std::atoi(need());
+    else if (a == "--duration-s")
+      mission_config.duration_s = std::atof(need());
+    else if (a == "--seed")
+      mission_config.seed = std::strtoull(need(), nullptr, 10);
+    else if (a == "--threads")
+      output.lidar.threads = std::max(1, std::atoi(need()));
+    else if (a == "--shared-rooms")
+      mission_config.shared_rooms = std::atoi(need());
+    else if (a == "--people")
+      mission_config.people.count = std::atoi(need());
+    else if (a == "--truth-rate-hz")
+      output.truth_rate_hz = std::atof(need());
+    else if (a == "--slip")
+      ok = OnOff(need(), output.odometry.slip.enabled);
+    else if (a == "--gait")
+      ok = OnOff(need(), mission_config.gait.enabled);
+    else if (a == "--visit-kinds") {
+      const auto kinds = VisitKinds::Parse(need(), error);
+      ok = kinds.has_value();
+      if (ok) mission_config.visit_kinds = *kinds;
+    } else if (a == "--start-delays") {
+      output.start_delays = need();
+      const auto delays = StartDelays::Parse(output.start_delays, error);
+      ok = delays.has_value();
+      if (ok) mission_config.start_delays = *delays;
+    }
     else if (a == "--building") {
       const char* text = need();
       char* end = nullptr;
       building_seed = std::strtoull(text, &end, 10);
       if (end == text || *end != '\0') {
-        std::fprintf(stderr, "msgraphs_sim: --building needs a seed (a whole number), not '%s'\n", text);
+        std::fprintf(stderr, "msgraphs_sim: --building needs a seed (a whole number), not '%s'\n",
+                     text);
         return 2;
       }
-    }
-    else if (a == "--world-out") world_out = need();
-    else if (msgraphs::sim::building::IsOption(a)) {
-      if (!msgraphs::sim::building::SetOption(a, need(), building_options, error)) {
-        std::fprintf(stderr, "msgraphs_sim: %s\n", error.c_str());
-        return 2;
-      }
+    } else if (a == "--world-out") {
+      world_out = need();
+    } else if (msgraphs::sim::building::IsOption(a)) {
+      ok = msgraphs::sim::building::SetOption(a, need(), building_options, error);
     } else {
+      Usage();
+      return 2;
+    }
+    if (!ok) {
+      if (!error.empty()) std::fprintf(stderr, "msgraphs_sim: %s\n", error.c_str());
       Usage();
       return 2;
     }
@@ -93,6 +151,10 @@ int main(int argc, char** argv) {
   if (world_path.empty() == !building_seed.has_value() || (!world_out.empty() && !building_seed) ||
       (out_dir.empty() && !validate_only && svg_path.empty() && world_out.empty())) {
     Usage();
+    return 2;
+  }
+  if (!(output.truth_rate_hz >= 10.0 && output.truth_rate_hz <= 1000.0)) {
+    std::fprintf(stderr, "msgraphs_sim: --truth-rate-hz must be 10..1000\n");
     return 2;
   }
   std::optional<World> world;
@@ -117,14 +179,15 @@ int main(int argc, char** argv) {
     }
   } else {
     world = LoadWorld(world_path, error);
+    output.world_path = world_path;
   }
   if (!world) {
     std::fprintf(stderr, "msgraphs_sim: %s\n", error.c_str());
     return 1;
   }
-  std::printf("world: %s (%s): %zu walls, %zu rooms, %zu boxes, %zu cylinders, %zu level(s)\n", world_path.c_str(),
-              world->name.c_str(), world->walls.size(), world->rooms.size(), world->boxes.size(),
-              world->cylinders.size(), world->levels.size());
+  std::printf("world: %s (%s): %zu walls, %zu rooms, %zu boxes, %zu cylinders, %zu level(s)\n",
+              world_path.c_str(), world->name.c_str(), world->walls.size(), world->rooms.size(),
+              world->boxes.size(), world->cylinders.size(), world->levels.size());
   std::fflush(stdout);
   if (validate_only) return 0;
   if (mission_config.robots < 1 || mission_config.robots > 10) {
@@ -144,64 +207,20 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (out_dir.empty()) return 0;
-
   namespace fs = std::filesystem;
-  fs::create_directories(fs::path(out_dir) / "truth");
-  if (building_seed) {
-    SaveWorld(*world, (fs::path(out_dir) / "world.world").string());
-    std::ofstream(fs::path(out_dir) / "building.txt") << building_text;
-  } else {
-    fs::copy_file(world_path, fs::path(out_dir) / "world.world", fs::copy_options::overwrite_existing);
+  if (!WriteMissionOutputs(*world, scene, *mission, output, out_dir, error)) {
+    std::fprintf(stderr, "msgraphs_sim: %s\n", error.c_str());
+    return 1;
   }
-  WriteWallsCsv(*world, (fs::path(out_dir) / "truth" / "walls.csv").string());
-  WriteRoomsCsv(*world, (fs::path(out_dir) / "truth" / "rooms.csv").string());
-  WriteSvg(*world, &*mission, mission_config.level, (fs::path(out_dir) / "map.svg").string());
-
-  std::ofstream summary(fs::path(out_dir) / "mission.txt");
-  summary << "msgraphs-mission 1\nworld " << world->name << "\nseed " << mission_config.seed << "\nduration_s "
-          << mission_config.duration_s << "\nrobots " << mission_config.robots << "\nshared_rooms";
-  for (const auto& r : mission->shared_rooms) summary << " " << r;
-  summary << "\n";
-
-  LidarSimConfig lidar;
-  lidar.nanosecond_pcap = pcap_ns;
-  lidar.threads = threads;
-  OdometrySimConfig odometry;
-  for (const RobotPlan& plan : mission->robots) {
-    const fs::path dir = fs::path(out_dir) / ("robot" + std::to_string(plan.id));
-    fs::create_directories(dir);
-    const RobotClocks clocks = RobotClocks::Draw(mission_config.seed, plan.id);
-    LidarSimStats ls;
-    OdometrySimStats os;
-    const auto r0 = std::chrono::steady_clock::now();
-    if (!RenderLidar(scene, plan.trajectory, lidar, clocks, mission_config.seed, plan.id,
-                     (dir / "velodyne.pcap").string(), ls, error) ||
-        !RenderOdometry(plan.trajectory, odometry, clocks, mission_config.seed, plan.id,
-                        (dir / "odometry.log").string(), os, error) ||
-        !WriteTum(plan.trajectory, clocks, 100.0, (dir / "ground_truth.tum").string()) ||
-        !WriteStartPose(plan, plan.trajectory.base_z_m(), (dir / "start_pose.txt").string())) {
-      std::fprintf(stderr, "msgraphs_sim: robot %d: %s\n", plan.id, error.empty() ? "write failed" : error.c_str());
+  if (building_seed) {  // the generated world and its feature summary beside the recordings
+    if (!SaveWorld(*world, (fs::path(out_dir) / "world.world").string()) ||
+        !(std::ofstream(fs::path(out_dir) / "building.txt") << building_text)) {
+      std::fprintf(stderr, "msgraphs_sim: cannot write the building into %s\n", out_dir.c_str());
       return 1;
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-    std::printf("robot %d: start %s (%.2f, %.2f, %.0f deg), %.0f m walked, rooms", plan.id, plan.start_room.c_str(),
-                plan.start.x, plan.start.y, plan.start.yaw * 57.29577951308232, os.path_length_m);
-    for (const auto& r : plan.rooms_visited) std::printf(" %s", r.c_str());
-    std::printf("\n  lidar: %llu packets, %.1f %% returns, %llu dropouts; odometry: %llu samples, %llu dropped, "
-                "scale error %+.2f %%, yaw drift %+.2f deg/10 m; %.1f s\n",
-                static_cast<unsigned long long>(ls.data_packets), 100.0 * static_cast<double>(ls.returns) / static_cast<double>(ls.rays),
-                static_cast<unsigned long long>(ls.dropouts), static_cast<unsigned long long>(os.samples),
-                static_cast<unsigned long long>(os.dropped), 100.0 * os.scale_error,
-                os.yaw_drift_rad_per_m * 10.0 * 57.29577951308232, seconds);
-    summary << "robot " << plan.id << " start_room " << plan.start_room << " unix_offset_s "
-            << std::to_string(clocks.unix_offset_s) << " scale_error " << os.scale_error << " yaw_drift_rad_per_m "
-            << os.yaw_drift_rad_per_m << " dropped_samples " << os.dropped << " path_m " << os.path_length_m
-            << " rooms";
-    for (const auto& r : plan.rooms_visited) summary << " " << r;
-    summary << "\n";
   }
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("rendered %d robots x %.0f s in %.1f s (%d threads) into %s\n", mission_config.robots,
-              mission_config.duration_s, total, threads, out_dir.c_str());
+              mission_config.duration_s, total, output.lidar.threads, out_dir.c_str());
   return 0;
 }

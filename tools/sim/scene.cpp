@@ -18,7 +18,8 @@ Scene::Scene(const World& world, int level, double cell_size_m) : cell_(cell_siz
 
   // Walls: solid pieces between doors at full height, lintels above doors. Pieces at the
   // wall's true ends grow by half the thickness so that corners close.
-  for (const Wall& w : world.walls) {
+  for (std::size_t wall_index = 0; wall_index < world.walls.size(); ++wall_index) {
+    const Wall& w = world.walls[wall_index];
     if (w.level != level) continue;
     const Eigen::Vector2d dir = w.direction();
     const double yaw_c = dir.x(), yaw_s = dir.y();
@@ -30,7 +31,7 @@ Scene::Scene(const World& world, int level, double cell_size_m) : cell_(cell_siz
       if (b - a < 1e-6 || z1 - z0 < 1e-6) return;
       const Eigen::Vector2d centre = w.start + dir * (0.5 * (a + b));
       boxes_.push_back({centre, yaw_c, yaw_s, 0.5 * (b - a), 0.5 * w.thickness_m, floor_z_ + z0,
-                        floor_z_ + z1, w.material});
+                        floor_z_ + z1, w.material, static_cast<std::int32_t>(wall_index)});
     };
     double cursor = -0.5 * w.thickness_m;
     for (const Door& d : doors) {
@@ -144,6 +145,10 @@ bool Scene::TestPrimitive(std::uint32_t id,
     if (axis == 0) best.normal = Eigen::Vector3d(sign * b.c, sign * b.s, 0);
     if (axis == 1) best.normal = Eigen::Vector3d(-sign * b.s, sign * b.c, 0);
     if (axis == 2) best.normal = Eigen::Vector3d(0, 0, sign);
+    // A wall piece's +-y faces are the wall's two faces (its y axis is the wall's normal()); the
+    // ray enters through the face whose outward normal is sign * normal().
+    best.wall = axis == 1 ? b.wall : -1;
+    best.face = static_cast<std::int8_t>(axis == 1 && b.wall >= 0 ? (sign > 0 ? 1 : -1) : 0);
     return true;
   }
   const CylinderPrimitive& c = cylinders_[id - boxes_.size()];
@@ -161,6 +166,8 @@ bool Scene::TestPrimitive(std::uint32_t id,
         best.range_m = t;
         best.material = c.material;
         best.normal = Eigen::Vector3d(px + t * d.x(), py + t * d.y(), 0).normalized();
+        best.wall = -1;
+        best.face = 0;
         hit = true;
       }
     }
@@ -172,6 +179,8 @@ bool Scene::TestPrimitive(std::uint32_t id,
       best.range_m = t;
       best.material = c.material;
       best.normal = {0, 0, 1};
+      best.wall = -1;
+      best.face = 0;
       hit = true;
     }
   }
@@ -189,13 +198,13 @@ std::optional<Hit> Scene::Cast(const Eigen::Vector3d& o,
   if (d.z() < -kEps) {
     const double t = (floor_z_ - o.z()) / d.z();
     if (t > 0 && t < best.range_m) {
-      best = {t, {0, 0, 1}, Material::kConcrete};
+      best = {t, {0, 0, 1}, Material::kConcrete, -1, 0};
       any = true;
     }
   } else if (d.z() > kEps && ceiling_z_) {
     const double t = (*ceiling_z_ - o.z()) / d.z();
     if (t > 0 && t < best.range_m) {
-      best = {t, {0, 0, -1}, Material::kPainted};
+      best = {t, {0, 0, -1}, Material::kPainted, -1, 0};
       any = true;
     }
   }

@@ -20,6 +20,13 @@ struct Hit {
   double range_m = 0.0;
   Eigen::Vector3d normal{0, 0, 1};  ///< unit, facing the ray
   Material material = Material::kPainted;
+  /// The world wall (index into World::walls) whose long face was hit: face +1 is the face its
+  /// normal() points out of (walls.csv face a), -1 the other (face b). wall = -1, face = 0 for
+  /// anything else: floor, ceiling, furniture, door reveals and wall ends, the underside of
+  /// lintels.
+  std::int32_t wall = -1;
+  std::int8_t face = 0;
+  std::int32_t person = -1;  ///< a simulated person (index into Mission::people), else -1
 };
 
 class Scene {
@@ -61,6 +68,7 @@ class Scene {
     double hx, hy;  // half extents along the box axes
     double z0, z1;
     Material material;
+    std::int32_t wall = -1;  // index into World::walls for wall pieces, -1 for furniture
   };
   struct CylinderPrimitive {
     Eigen::Vector2d centre;

@@ -21,9 +21,13 @@ PlanarPose Trajectory::Planar(double t) const {
 
 Eigen::Isometry3d Trajectory::Pose(double t) const {
   const PlanarPose p = Planar(t);
+  const GaitOffsets g = gait_.At(t / dt_);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() = Eigen::Vector3d(p.x, p.y, base_z_);
+  T.linear() = (Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(g.pitch_rad, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(g.roll_rad, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(p.x, p.y, base_z_ + g.z_m);
   return T;
 }
 

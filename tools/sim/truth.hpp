@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Ground truth and pictures: TUM trajectories of each robot's base frame in the world frame
-// (stamped by the robot's own clock), true start poses, the world's true walls (both faces as
-// planes) and rooms (centre, orientation, size, polygon), and a top-down SVG.
+// (full 6-DOF with the gait, stamped by the robot's own clock, at any rate), true start poses, the
+// world's true walls (both faces as planes) and rooms (centre, orientation, size, polygon), and a
+// top-down SVG.
 #pragma once
 
 #include <string>
@@ -12,8 +13,12 @@
 
 namespace msgraphs::sim {
 
-bool WriteTum(const Trajectory& trajectory, const RobotClocks& clocks, double rate_hz, const std::string& path);
-bool WriteStartPose(const RobotPlan& plan, double base_z_m, const std::string& path);
+bool WriteTum(const Trajectory& trajectory,
+              const RobotClocks& clocks,
+              double rate_hz,
+              const std::string& path);
+/// The true T_world_base at the robot's start (its trajectory's t = 0), yaw and start room.
+bool WriteStartPose(const RobotPlan& plan, const std::string& path);
 bool WriteWallsCsv(const World& world, const std::string& path);
 bool WriteRoomsCsv(const World& world, const std::string& path);
 bool WriteSvg(const World& world, const Mission* mission, int level, const std::string& path);

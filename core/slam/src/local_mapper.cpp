@@ -219,10 +219,28 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
                                     std::span<const std::uint32_t>(recent_scratch_.data(), count)))
       return Error{Errc::kDegenerate, "relocalise: no map near the search"};
   }
-  const Eigen::Vector3d span = to.translation() - from.translation();
+  // Seeds are laid out in the gravity-aligned map: along the segment at the height where the
+  // node stopped (a legged robot walks on the floor; a prediction that extrapolated a rocking
+  // base's last step tilts the segment out of it) and level, at headings relative to the last
+  // keyframe's. Spot's trot rocks the base by degrees: seeds off the floor, or level with the
+  // last keyframe's rocked base (its tilt added to the new one's), miss
+  // (LocalMapper/Relocalisation with a rocking base).
+  const Eigen::Isometry3d& T_map_last = graph_.keyframe_pose(last_keyframe_);
+  const double yaw_map_last = std::atan2(T_map_last.linear()(1, 0), T_map_last.linear()(0, 0));
+  const Eigen::Vector3d from_map = T_map_last * from.translation();
+  Eigen::Vector3d span = T_map_last * to.translation() - from_map;
+  span.z() = 0;
   const double yaw_from = std::atan2(from.linear()(1, 0), from.linear()(0, 0));
   double yaw_span = std::atan2(to.linear()(1, 0), to.linear()(0, 0)) - yaw_from;
   yaw_span = std::atan2(std::sin(yaw_span), std::cos(yaw_span));
+  const Eigen::Isometry3d T_last_map = T_map_last.inverse();
+  // T_last_seed for a level base at p_map (map frame), heading yaw_rad from the last keyframe's.
+  const auto seed_at = [&](const Eigen::Vector3d& p_map, double yaw_rad) {
+    Eigen::Isometry3d T_map_seed = Eigen::Isometry3d::Identity();
+    T_map_seed.linear() = RotZ(yaw_map_last + yaw_rad);
+    T_map_seed.translation() = p_map;
+    return T_last_map * T_map_seed;
+  };
   const int steps = static_cast<int>(std::ceil(span.head<2>().norm() / search.step_m));
   const int sides = static_cast<int>(std::floor(search.lateral_m / search.step_m + 1e-9));
   const int turns = search.yaw_step_rad > 0
@@ -243,18 +261,18 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
   Relocalisation best;
   for (int i = -1; i <= steps + 1; ++i) {
     const double f = steps == 0 ? 0.0 : static_cast<double>(i) / steps;  // beyond [0, 1] by a step
-    Eigen::Isometry3d on_segment = Eigen::Isometry3d::Identity();
-    on_segment.linear() = RotZ(yaw_from + f * yaw_span);
-    on_segment.translation() = from.translation() + f * span;
-    if (steps == 0) on_segment.translation().x() += i * search.step_m;  // no span: along x
+    const double yaw = yaw_from + f * yaw_span;
+    const Eigen::Matrix3d R_heading = RotZ(yaw_map_last + yaw);
+    Eigen::Vector3d on_segment = from_map + f * span;
+    if (steps == 0)
+      on_segment += R_heading * Eigen::Vector3d(i * search.step_m, 0, 0);  // no span: ahead
     for (int side = -sides; side <= sides; ++side) {
       for (int turn = -turns; turn <= turns; ++turn) {
         if (best.candidates >= search.max_candidates) break;
         ++best.candidates;
         Ranked r;
-        r.seed = on_segment;
-        r.seed.translation() += on_segment.linear() * Eigen::Vector3d(0, side * search.step_m, 0);
-        r.seed.linear() = r.seed.linear() * RotZ(turn * search.yaw_step_rad);
+        r.seed = seed_at(on_segment + R_heading * Eigen::Vector3d(0, side * search.step_m, 0),
+                         yaw + turn * search.yaw_step_rad);
         r.score = 0;
         for (std::size_t k = 0; k < down_.size(); k += stride) {
           const Eigen::Vector3d q = r.seed * down_[k].cast<double>();
