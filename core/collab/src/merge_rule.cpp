@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/collab/merge_rule.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <limits>
+
 namespace msgraphs::core {
 namespace {
 
@@ -29,6 +33,8 @@ const char* ToString(MergeVerdict v) {
       return "a rival stands within the margin";
     case MergeVerdict::kTruncated:
       return "search truncated (a bounded store was full)";
+    case MergeVerdict::kContradicted:
+      return "the strongest hypothesis is refuted by free space";
     case MergeVerdict::kMerge:
       return "merge";
   }
@@ -113,6 +119,21 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
       out.verdict = MergeVerdict::kConflicted;
       return out;
     }
+    // Rule 5: the refuted hypotheses are those before the leader (sorted by agreement). One
+    // that beats the leader by the margin both in agreement and in its weakest direction is
+    // stronger evidence in every respect (a corridor's slide, strong along the corridor only,
+    // does not count).
+    for (int i = 0; i < leader; ++i) {
+      const Hypothesis& h = in.hypotheses[static_cast<std::size_t>(i)];
+      if (!h.conflict_known || Standing(h, c) || SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) continue;
+      if (!Beats(h, L, c.margin_ratio, c) ||
+          h.agreement.constraint_m < c.margin_ratio * L.agreement.constraint_m + c.margin_m)
+        continue;
+      out.verdict = MergeVerdict::kContradicted;
+      out.best_refuted = h;
+      out.has_best_refuted = true;
+      return out;
+    }
   }
   // Symmetry alternatives: each map's symmetry composed with the leader.
   Hypothesis best_symmetric;
@@ -130,6 +151,31 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
   };
   for (std::size_t k = 0; k < in.sym_a.size() && k < c.max_symmetries; ++k) consider(in.sym_a[k].T_a_b * L.T_a_b);
   for (std::size_t k = 0; k < in.sym_b.size() && k < c.max_symmetries; ++k) consider(L.T_a_b * in.sym_b[k].T_a_b);
+  // Slides along the leader's weakest direction (rule 4): a repeated structure along it (racks
+  // at a pitch, a row of doors) lays b on another copy with the walls along the slide still
+  // coinciding. Probed every 2 agreement offsets (so refinement captures any alternative) over
+  // the extent of b's walls along the direction, at most max_slide_probes each way.
+  if (c.max_slide_probes > 0 && L.agreement.pairs > 0) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(L.agreement.information);
+    const Eigen::Vector2d dir = eig.eigenvectors().col(0);  // the smallest eigenvalue's
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const AlignWall& w : in.walls_b->walls()) {
+      for (const Eigen::Vector2d& p : {w.a, w.b}) {
+        const double s = dir.dot(L.T_a_b * p);
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+      }
+    }
+    const double span_m = hi > lo ? hi - lo : 0.0;
+    const double step_m = std::max(2 * search.config().agreement.offset_m, span_m / static_cast<double>(c.max_slide_probes));
+    for (double s = step_m; s <= span_m; s += step_m) {
+      for (const double sign : {1.0, -1.0}) {
+        PlanarTransform T = L.T_a_b;
+        T.t_m += sign * s * dir;
+        consider(T);
+      }
+    }
+  }
   out.symmetric = has_symmetric;
   const double ratio = has_symmetric ? c.symmetric_margin_ratio : c.margin_ratio;
   // The strongest standing rival among the hypotheses (they are sorted by agreement: the first

@@ -18,7 +18,13 @@
 //    on another copy of the same structure. If one of them is not refuted, the structure the
 //    robots share repeats and the difference in agreement may be nothing but which copy each
 //    robot saw more of: the margin becomes `symmetric_margin_ratio`, and the alternative is a
-//    rival too.
+//    rival too. So are the leader's slides along its weakest direction that stand (a structure
+//    repeated along it: racks at a pitch).
+// 5. No refuted hypothesis may beat the leader by the margin, in agreement and in its weakest
+//    direction both (kContradicted): when the strongest evidence two maps have in common is
+//    contradicted, the likeliest explanation is an error in the free space or the maps (the
+//    true transform refuted by an artefact), not that a much weaker alternative is true; and a
+//    weaker alternative is what a repeated structure (a mirrored wing) offers.
 // Then: merge with the leader. A merged pair is kept while its hypothesis has at most
 // `undo_conflict_m` of conflict and no rival beats it by the margin (hysteresis: accept at
 // accept_conflict_m, refute others beyond refute_conflict_m, undo a merge beyond
@@ -45,7 +51,9 @@ namespace msgraphs::core {
 
 struct MergeRuleConfig {
   double min_agreement_m = 8.0;
-  double min_constraint_m = 3.0;
+  /// Both directions fixed by at least this much coinciding wall: more than the jambs of a door
+  /// and a rack end or two (1-2 m each), which coincide by chance in a repeated layout.
+  double min_constraint_m = 6.0;
   double accept_conflict_m = 0.25;
   double refute_conflict_m = 0.5;
   /// A merged transform is undone only beyond this much conflict (or a rival beating it): the
@@ -56,6 +64,9 @@ struct MergeRuleConfig {
   double margin_m = 3.0;
   double symmetric_margin_ratio = 3.0;
   std::size_t max_symmetries = 16;  ///< each map's strongest symmetries composed with the leader
+  /// Slides of the leader along its weakest direction probed each way (rule 4); 0: none. The
+  /// probes are 2 agreement offsets apart, wider when b's extent needs more than this many.
+  std::size_t max_slide_probes = 128;
   FreeSpaceConflictConfig conflict;
   Status Validate() const;
 };
@@ -68,6 +79,9 @@ enum class MergeVerdict : std::uint8_t {
   kConflicted,    ///< the leader contradicts a little: not refuted, not acceptable
   kAmbiguous,     ///< a rival stands within the margin
   kTruncated,     ///< the search lost candidates (a bounded store was full)
+  /// The strongest evidence (a hypothesis beating the leader by the margin) is refuted: either
+  /// the free space is in error or the maps disagree; a weaker alternative is not trusted.
+  kContradicted,
   kMerge,
 };
 const char* ToString(MergeVerdict verdict);
