@@ -367,13 +367,14 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(gs.solves_undone));
   std::printf(
       "scan matching: %llu accepted; rejected fitness %llu, overlap %llu, diverged %llu, failed "
-      "%llu; odometry gaps at %llu keyframes\n",
+      "%llu; odometry gaps at %llu keyframes, slips gated at %llu\n",
       static_cast<unsigned long long>(ms.scan_match_accepted),
       static_cast<unsigned long long>(ms.scan_match_rejected_fitness),
       static_cast<unsigned long long>(ms.scan_match_rejected_overlap),
       static_cast<unsigned long long>(ms.scan_match_rejected_diverged),
       static_cast<unsigned long long>(ms.scan_match_rejected_failed),
-      static_cast<unsigned long long>(ms.odometry_gap_keyframes));
+      static_cast<unsigned long long>(ms.odometry_gap_keyframes),
+      static_cast<unsigned long long>(ms.odometry_slips));
   const auto& ls = mapper.loop_closer().stats();
   std::printf(
       "loop closure: %llu queries, %llu candidates, %llu verified, %llu accepted (fitness %llu, "

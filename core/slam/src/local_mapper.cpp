@@ -47,6 +47,7 @@ Status LocalMapperConfig::Validate() const {
       !(max_correction_rad > 0) || !(odometry_sigma_min_m > 0) ||
       !(odometry_rotation_sigma_min > 0) || !(odometry_sigma_per_m >= 0) ||
       !(odometry_rotation_sigma_per_m >= 0) || !(odometry_gap_inflation >= 1) ||
+      !(odometry_gate_chi2 >= 0) ||
       room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 || max_plane_priors < 1 ||
       cloud_store_points < max_scan_points || odometry_capacity < 16 || !(odometry_max_gap_s > 0)) {
     return Error{Errc::kInvalidConfig,
@@ -402,7 +403,21 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   keyframe_odometry_[id] = T_odom_now;
   if (have_keyframe_) {
     if (across_gap) ++stats_.odometry_gap_keyframes;
-    if (!graph_.AddRelativePose(last_keyframe_, id, delta, OdometryInformation(delta, across_gap),
+    Matrix6d odometry_information = OdometryInformation(delta, across_gap);
+    if (matched && config_.odometry_gate_chi2 > 0) {
+      // The slip gate: the two measurements of this step against their combined covariance.
+      const Eigen::Isometry3d disagreement = delta.inverse() * T_last_new;
+      const Eigen::AngleAxisd turn(disagreement.linear());
+      Eigen::Matrix<double, 6, 1> e;
+      e << disagreement.translation(), turn.angle() * turn.axis();
+      const Matrix6d covariance = odometry_information.inverse() + match_information.inverse();
+      const double d2 = e.dot(covariance.ldlt().solve(e));
+      if (std::isfinite(d2) && d2 > config_.odometry_gate_chi2) {
+        odometry_information *= 6.0 / d2;  // the disagreement at its expectation, 6 dof
+        ++stats_.odometry_slips;
+      }
+    }
+    if (!graph_.AddRelativePose(last_keyframe_, id, delta, odometry_information,
                                 RelativePoseKind::kOdometry)) {
       ++stats_.chain_factors_refused;
     }

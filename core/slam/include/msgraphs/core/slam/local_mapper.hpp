@@ -72,6 +72,12 @@ struct LocalMapperConfig {
   double odometry_sigma_per_m = 0.03, odometry_sigma_min_m = 0.01;
   double odometry_rotation_sigma_per_m = 0.005, odometry_rotation_sigma_min = 0.002;
   double odometry_gap_inflation = 10.0;  ///< sigma factor when the odometry bridged a gap
+  /// Slip gate: when an accepted scan match and the encoder odometry of the same step disagree
+  /// beyond this chi-square value (6 degrees of freedom, 99.9 %: 22.46) under their combined
+  /// covariance, the encoders misreported (a foot slipped) and the step's odometry factor is
+  /// weakened until the disagreement is at the gate's expectation (counted: odometry_slips).
+  /// Without it a 2 s slip pulls the map by centimetres against the scan matches. 0: off.
+  double odometry_gate_chi2 = 22.46;
   std::size_t room_update_every_keyframes = 5;
   std::size_t full_solve_every_keyframes = 50;
   std::size_t max_plane_priors = 256;  ///< external wall priors held at once (SetPlanePriors)
@@ -124,6 +130,7 @@ struct LocalMapperStats {
   std::uint64_t scans = 0, keyframes = 0;
   std::uint64_t no_odometry = 0;  ///< scan outside the odometry buffered (skipped, counted)
   std::uint64_t odometry_gap_keyframes = 0;
+  std::uint64_t odometry_slips = 0;  ///< steps whose odometry the slip gate weakened
   std::uint64_t bad_scans = 0;  ///< too few points, or mismatched spans
   std::uint64_t scan_match_accepted = 0;
   std::uint64_t scan_match_rejected_fitness = 0, scan_match_rejected_overlap = 0,
