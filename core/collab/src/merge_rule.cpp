@@ -73,12 +73,20 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
   int leader = -1;
   Hypothesis L;
   bool keeping = false;
+  // The current merge as it stands now, when it no longer does (rule 5).
+  Hypothesis fallen;
+  bool has_fallen = false;
   if (current != nullptr) {
     for (std::size_t i = 0; i < in.hypotheses.size() && leader < 0; ++i) {
       Hypothesis& h = in.hypotheses[i];
       if (!SameTransform(h.T_a_b, *current, 2 * same_m, 2 * same_rad)) continue;
       MeasureConflict(h, in, cc);
-      if (StillStanding(h, c)) leader = static_cast<int>(i);
+      if (StillStanding(h, c)) {
+        leader = static_cast<int>(i);
+      } else if (!has_fallen || h.agreement.agreement_m > fallen.agreement.agreement_m) {
+        fallen = h;
+        has_fallen = true;
+      }
     }
     if (leader >= 0) {
       L = in.hypotheses[static_cast<std::size_t>(leader)];
@@ -90,6 +98,9 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
       if (StillStanding(h, c) && h.agreement.constraint_m >= c.min_rival_constraint_m) {
         L = h;
         keeping = true;
+      } else if (!has_fallen) {
+        fallen = h;
+        has_fallen = true;
       }
     }
   }
@@ -123,6 +134,16 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     // that beats the leader by the margin both in agreement and in its weakest direction is
     // stronger evidence in every respect (a corridor's slide, strong along the corridor only,
     // does not count).
+    // The merge this pair had, now contradicted, is such evidence too as long as it agrees at
+    // least as much as the new leader: a merge is not moved to another transform by the same
+    // exchange that refuted it (a person in a doorway, a door closed since), only undone.
+    if (has_fallen && !SameTransform(fallen.T_a_b, L.T_a_b, same_m, same_rad) &&
+        fallen.agreement.agreement_m >= L.agreement.agreement_m) {
+      out.verdict = MergeVerdict::kContradicted;
+      out.best_refuted = fallen;
+      out.has_best_refuted = true;
+      return out;
+    }
     for (int i = 0; i < leader; ++i) {
       const Hypothesis& h = in.hypotheses[static_cast<std::size_t>(i)];
       if (!h.conflict_known || Standing(h, c) || SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) continue;
@@ -151,28 +172,33 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
   };
   for (std::size_t k = 0; k < in.sym_a.size() && k < c.max_symmetries; ++k) consider(in.sym_a[k].T_a_b * L.T_a_b);
   for (std::size_t k = 0; k < in.sym_b.size() && k < c.max_symmetries; ++k) consider(L.T_a_b * in.sym_b[k].T_a_b);
-  // Slides along the leader's weakest direction (rule 4): a repeated structure along it (racks
-  // at a pitch, a row of doors) lays b on another copy with the walls along the slide still
-  // coinciding. Probed every 2 agreement offsets (so refinement captures any alternative) over
-  // the extent of b's walls along the direction, at most max_slide_probes each way.
+  // Slides of the leader along both principal directions of its agreement (rule 4): a
+  // structure repeated along one (racks at a pitch, a row of doors, a hall's bays) lays b on
+  // another copy, with the walls along the slide still coinciding and the walls across it
+  // landing on the next copy's. Probed every 2 agreement offsets (refinement captures any
+  // alternative in between) over the extent of b's walls along the direction, at most
+  // max_slide_probes each way.
   if (c.max_slide_probes > 0 && L.agreement.pairs > 0) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(L.agreement.information);
-    const Eigen::Vector2d dir = eig.eigenvectors().col(0);  // the smallest eigenvalue's
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const AlignWall& w : in.walls_b->walls()) {
-      for (const Eigen::Vector2d& p : {w.a, w.b}) {
-        const double s = dir.dot(L.T_a_b * p);
-        lo = std::min(lo, s);
-        hi = std::max(hi, s);
+    for (int axis = 0; axis < 2; ++axis) {
+      const Eigen::Vector2d dir = eig.eigenvectors().col(axis);
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const AlignWall& w : in.walls_b->walls()) {
+        for (const Eigen::Vector2d& p : {w.a, w.b}) {
+          const double s = dir.dot(L.T_a_b * p);
+          lo = std::min(lo, s);
+          hi = std::max(hi, s);
+        }
       }
-    }
-    const double span_m = hi > lo ? hi - lo : 0.0;
-    const double step_m = std::max(2 * search.config().agreement.offset_m, span_m / static_cast<double>(c.max_slide_probes));
-    for (double s = step_m; s <= span_m; s += step_m) {
-      for (const double sign : {1.0, -1.0}) {
-        PlanarTransform T = L.T_a_b;
-        T.t_m += sign * s * dir;
-        consider(T);
+      const double span_m = hi > lo ? hi - lo : 0.0;
+      const double step_m =
+          std::max(2 * search.config().agreement.offset_m, span_m / static_cast<double>(c.max_slide_probes));
+      for (double s = step_m; s <= span_m; s += step_m) {
+        for (const double sign : {1.0, -1.0}) {
+          PlanarTransform T = L.T_a_b;
+          T.t_m += sign * s * dir;
+          consider(T);
+        }
       }
     }
   }

@@ -214,6 +214,12 @@ bool ParseNodeConfig(const std::string& text,
   r.Path("odometry", "candump", c.candump_path);
   r.String("odometry", "interface", c.can_interface);
   r.Integer("odometry", "udp_port", 0, 65535, c.can_udp_port);
+  // The odometry factor's noise (LocalMapperConfig): the robot's odometry, not the simulator's.
+  r.Number("odometry", "sigma_per_m", 0.0, 1.0, c.mapper.odometry_sigma_per_m);
+  r.Number("odometry", "sigma_min_m", 1e-4, 1.0, c.mapper.odometry_sigma_min_m);
+  r.Number("odometry", "rotation_sigma_per_m", 0.0, 1.0, c.mapper.odometry_rotation_sigma_per_m);
+  r.Number("odometry", "rotation_sigma_min_rad", 1e-5, 1.0, c.mapper.odometry_rotation_sigma_min);
+  r.Number("odometry", "slip_gate_chi2", 0.0, 1e6, c.mapper.odometry_gate_chi2);
 
   r.Choice("replay", "pace", kPaces, c.pace);
   r.Number("replay", "speed", 0.01, 1000, c.speed);
@@ -226,6 +232,15 @@ bool ParseNodeConfig(const std::string& text,
   r.Float("mapping", "min_range_m", 0.0, 10.0, c.mapper.min_range_m);
   r.Float("mapping", "max_range_m", 1.0, 120.0, c.mapper.max_range_m);
   r.Integer("mapping", "max_keyframes", 16, 1000000, c.mapper.graph.max_keyframes);
+  r.Integer("mapping", "cloud_store_points", 100000, 100000000, c.mapper.cloud_store_points);
+  // The free-space grid: a square centred on the start, at its resolution (memory grows with
+  // the square of the extent: 1024 x 1024 cells at the default).
+  double grid_half_extent_m =
+      0.5 * static_cast<double>(c.mapper.grid.width) * static_cast<double>(c.mapper.grid.resolution_m);
+  r.Number("mapping", "grid_half_extent_m", 10.0, 1000.0, grid_half_extent_m);
+  const int cells = static_cast<int>(std::ceil(2.0 * grid_half_extent_m / static_cast<double>(c.mapper.grid.resolution_m)));
+  c.mapper.grid.width = c.mapper.grid.height = cells;
+  c.mapper.grid.origin_m = Eigen::Vector2f::Constant(-0.5f * static_cast<float>(cells) * c.mapper.grid.resolution_m);
 
   int mode = 3;
   r.Choice("collab", "mode", kModes, mode);

@@ -18,8 +18,8 @@
 //    on another copy of the same structure. If one of them is not refuted, the structure the
 //    robots share repeats and the difference in agreement may be nothing but which copy each
 //    robot saw more of: the margin becomes `symmetric_margin_ratio`, and the alternative is a
-//    rival too. So are the leader's slides along its weakest direction that stand (a structure
-//    repeated along it: racks at a pitch).
+//    rival too. So are the leader's slides along either principal direction of its agreement that
+//    stand (a structure repeated along it: racks at a pitch, a hall's bays).
 // 5. No refuted hypothesis may beat the leader by the margin, in agreement and in its weakest
 //    direction both (kContradicted): when the strongest evidence two maps have in common is
 //    contradicted, the likeliest explanation is an error in the free space or the maps (the
@@ -64,7 +64,7 @@ struct MergeRuleConfig {
   double margin_m = 3.0;
   double symmetric_margin_ratio = 3.0;
   std::size_t max_symmetries = 16;  ///< each map's strongest symmetries composed with the leader
-  /// Slides of the leader along its weakest direction probed each way (rule 4); 0: none. The
+  /// Slides of the leader along each principal direction probed each way (rule 4); 0: none. The
   /// probes are 2 agreement offsets apart, wider when b's extent needs more than this many.
   std::size_t max_slide_probes = 128;
   FreeSpaceConflictConfig conflict;

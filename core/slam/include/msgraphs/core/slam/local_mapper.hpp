@@ -67,8 +67,12 @@ struct LocalMapperConfig {
   double scan_match_min_overlap = 0.5;
   double max_correction_m = 0.25;   ///< scan matching may move the odometry's guess this much
   double max_correction_rad = 0.1;  ///< ...and turn it this much, else it diverged
-  /// Encoder odometry factor: sigma grows with the motion (Spot's drawn 1-2 % scale error and
-  /// ~1 degree per 10 m of yaw drift fit well inside these).
+  /// Encoder odometry factor: sigma grows with the motion. Configuration values from the
+  /// robot's odometry, not fitted: 3 % of the distance (a legged robot's encoders: 1-2 % scale
+  /// error, twice that as margin) and 0.005 rad a metre (0.3 degrees, about three times the
+  /// drift of 1 degree per 10 m Spot's state estimate is quoted at); the floors are the
+  /// encoders' resolution. A robot with other odometry sets its own (the node's [odometry] keys); slips
+  /// beyond them are caught by the slip gate below.
   double odometry_sigma_per_m = 0.03, odometry_sigma_min_m = 0.01;
   double odometry_rotation_sigma_per_m = 0.005, odometry_rotation_sigma_min = 0.002;
   double odometry_gap_inflation = 10.0;  ///< sigma factor when the odometry bridged a gap
