@@ -88,10 +88,10 @@ const char* Cause(const ViewEvaluation& v, const ViewExplanation& e, const core:
   if (v.history.unmerges() > 0) return "merged, then undone";
   if (!e.checked) return "no free space";
   if (!e.proposed) return "truth not proposed";
-  if (e.truth.conflict_m() > rule.refute_conflict_m) return "truth refuted";
+  if (e.truth.conflict_m() > rule.RefuteLimit(e.truth)) return "truth refuted";
   if (e.truth.agreement.agreement_m < rule.min_agreement_m || e.truth.agreement.constraint_m < rule.min_constraint_m)
     return "too little shared";
-  if (e.truth.conflict_m() > rule.accept_conflict_m) return "truth conflicted";
+  if (e.truth.conflict_m() > rule.AcceptLimit(e.truth)) return "truth conflicted";
   if (e.decision.verdict == core::MergeVerdict::kAmbiguous) return "ambiguous";
   if (e.decision.verdict == core::MergeVerdict::kTruncated) return "search truncated";
   return "undecided at the end";

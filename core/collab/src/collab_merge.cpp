@@ -112,11 +112,23 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
     in.sym_b = p.symmetries.span();
     d = DecideMerge(in, search, config.merge, p.merged ? &p.T_merge : nullptr);
   }
+  const double same_m = config.search.same_distance_m, same_rad = config.search.same_angle_rad;
+  // Confirmation: a new merge, or a move to another transform, needs the same leader in
+  // `confirmations` consecutive decisions; the current merge refined on new walls does not.
+  if (d.verdict == MergeVerdict::kMerge && !d.keeping) {
+    if (p.pending_count > 0 && SameTransform(d.leader.T_a_b, p.pending_T, 2 * same_m, 2 * same_rad))
+      ++p.pending_count;
+    else
+      p.pending_count = 1;
+    p.pending_T = d.leader.T_a_b;
+    if (p.pending_count < config.merge.confirmations) d.verdict = MergeVerdict::kUnconfirmed;
+  } else if (d.verdict != MergeVerdict::kMerge) {
+    p.pending_count = 0;
+  }
   p.decision = d;
 
   // Apply it: merge, revise, keep, undo.
   bool changed = false;
-  const double same_m = config.search.same_distance_m, same_rad = config.search.same_angle_rad;
   if (d.verdict == MergeVerdict::kMerge) {
     if (!p.merged) {
       p.merged = true;

@@ -95,6 +95,10 @@ struct CollabSession::Impl {
     MergeDecision decision;
     bool merged = false;
     PlanarTransform T_merge;  // the merge's hypothesis (planar)
+    // The leader awaiting confirmation (MergeRuleConfig::confirmations) and in how many
+    // consecutive decisions it led.
+    PlanarTransform pending_T;
+    std::uint32_t pending_count = 0;
     std::uint32_t solved_version = 0;  // its graph's version at the last solve
     Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();
     CollabPeerStats stats;

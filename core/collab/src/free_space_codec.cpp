@@ -15,17 +15,6 @@ constexpr std::size_t kHeader = 4 + 1 + 2 + 4 + 4 + 4 + 4 + 2 + 2 + 4 + 2;  // 3
 constexpr std::size_t kOpeningBytes = 16;
 constexpr int kMaxRun = 64;
 
-void PutF32(std::uint8_t* p, float f) {
-  std::uint32_t u;
-  std::memcpy(&u, &f, 4);
-  WriteU32Le(p, u);
-}
-float GetF32(const std::uint8_t* p) {
-  const std::uint32_t u = ReadU32Le(p);
-  float f;
-  std::memcpy(&f, &u, 4);
-  return f;
-}
 
 }  // namespace
 
@@ -40,9 +29,9 @@ Expected<std::size_t> EncodeFreeSpace(const FreeSpaceHeader& h, const FreeSpaceS
   p[4] = kFormat;
   WriteU16Le(p + 5, h.robot);
   WriteU32Le(p + 7, h.version);
-  PutF32(p + 11, static_cast<float>(summary.origin_m().x()));
-  PutF32(p + 15, static_cast<float>(summary.origin_m().y()));
-  PutF32(p + 19, summary.cell_m());
+  WriteF32Le(p + 11, static_cast<float>(summary.origin_m().x()));
+  WriteF32Le(p + 15, static_cast<float>(summary.origin_m().y()));
+  WriteF32Le(p + 19, summary.cell_m());
   WriteU16Le(p + 23, static_cast<std::uint16_t>(summary.width()));
   WriteU16Le(p + 25, static_cast<std::uint16_t>(summary.height()));
   std::size_t at = kHeader;
@@ -66,10 +55,10 @@ Expected<std::size_t> EncodeFreeSpace(const FreeSpaceHeader& h, const FreeSpaceS
   if (at + summary.openings().size() * kOpeningBytes + 4 > out.size())
     return Error{Errc::kCapacityExceeded, "free space: output buffer too small"};
   for (const Opening& o : summary.openings()) {
-    PutF32(p + at, static_cast<float>(o.a.x()));
-    PutF32(p + at + 4, static_cast<float>(o.a.y()));
-    PutF32(p + at + 8, static_cast<float>(o.b.x()));
-    PutF32(p + at + 12, static_cast<float>(o.b.y()));
+    WriteF32Le(p + at, static_cast<float>(o.a.x()));
+    WriteF32Le(p + at + 4, static_cast<float>(o.a.y()));
+    WriteF32Le(p + at + 8, static_cast<float>(o.b.x()));
+    WriteF32Le(p + at + 12, static_cast<float>(o.b.y()));
     at += kOpeningBytes;
   }
   WriteU32Le(p + at, Crc32(out.first(at)));
@@ -93,8 +82,8 @@ Expected<FreeSpaceHeader> DecodeFreeSpace(std::span<const std::uint8_t> bytes,
     return Error{Errc::kMalformed, "free space: bad magic"};
   if (bytes[4] != kFormat) return Error{Errc::kUnsupported, "free space: unknown format"};
   FreeSpaceHeader h{ReadU16Le(&bytes[5]), ReadU32Le(&bytes[7])};
-  const Eigen::Vector2d origin(GetF32(&bytes[11]), GetF32(&bytes[15]));
-  const float cell = GetF32(&bytes[19]);
+  const Eigen::Vector2d origin(ReadF32Le(&bytes[11]), ReadF32Le(&bytes[15]));
+  const float cell = ReadF32Le(&bytes[19]);
   const int width = ReadU16Le(&bytes[23]), height = ReadU16Le(&bytes[25]);
   const std::uint32_t runs = ReadU32Le(&bytes[27]);
   const std::size_t openings = ReadU16Le(&bytes[31]);
@@ -119,7 +108,7 @@ Expected<FreeSpaceHeader> DecodeFreeSpace(std::span<const std::uint8_t> bytes,
   }
   if (at != total) return Error{Errc::kMalformed, "free space: runs do not fill the grid"};
   for (std::size_t i = runs_end; i < body; i += kOpeningBytes) {
-    const Opening o{{GetF32(&bytes[i]), GetF32(&bytes[i + 4])}, {GetF32(&bytes[i + 8]), GetF32(&bytes[i + 12])}};
+    const Opening o{{ReadF32Le(&bytes[i]), ReadF32Le(&bytes[i + 4])}, {ReadF32Le(&bytes[i + 8]), ReadF32Le(&bytes[i + 12])}};
     if (!o.a.allFinite() || !o.b.allFinite() || o.a.cwiseAbs().maxCoeff() > 1e5 ||
         o.b.cwiseAbs().maxCoeff() > 1e5 || (o.b - o.a).norm() > 100.0) {
       return Error{Errc::kMalformed, "free space: opening not finite or implausible"};

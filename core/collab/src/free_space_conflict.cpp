@@ -60,7 +60,8 @@ bool SameDoorway(const FreeSpaceSummary& y, const Eigen::Vector2d& a, const Eige
 Status FreeSpaceConflictConfig::Validate() const {
   if (!(clearance_m > 0) || !(sample_step_m > 0.01 && sample_step_m <= 1.0) || !(opening_margin_m >= 0) ||
       !(extent_tolerance_m >= 0) || !(max_opening_m >= 0) ||
-      !(door_solid_share > 0 && door_solid_share <= 1) || !(min_stretch_m >= 0) || !(door_wall_distance_m > 0)) {
+      !(door_solid_share > 0 && door_solid_share <= 1) || !(min_stretch_m >= 0) || !(door_wall_distance_m > 0) ||
+      !(min_door_m >= 0)) {
     return Error{Errc::kInvalidConfig, "free-space conflict: distances and shares must be positive"};
   }
   return Ok();
@@ -103,6 +104,7 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
   for (const Opening& o : summary_x.openings()) {
     const Eigen::Vector2d a = T_y_x * o.a, b = T_y_x * o.b;
     const double width = (b - a).norm();
+    if (width < c.min_door_m) continue;  // narrower than any door: a gap between returns
     const auto n = std::max(1, static_cast<int>(std::ceil(width / step)));
     double solid = 0;
     for (int i = 0; i < n; ++i) {

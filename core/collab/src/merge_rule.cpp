@@ -8,8 +8,8 @@
 namespace msgraphs::core {
 namespace {
 
-bool Standing(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.refute_conflict_m; }
-bool StillStanding(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.undo_conflict_m; }
+bool Standing(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.RefuteLimit(h); }
+bool StillStanding(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.UndoLimit(h); }
 
 bool Beats(const Hypothesis& leader, const Hypothesis& rival, double ratio, const MergeRuleConfig& c) {
   return leader.agreement.agreement_m >= ratio * rival.agreement.agreement_m + c.margin_m;
@@ -35,6 +35,8 @@ const char* ToString(MergeVerdict v) {
       return "search truncated (a bounded store was full)";
     case MergeVerdict::kContradicted:
       return "the strongest hypothesis is refuted by free space";
+    case MergeVerdict::kUnconfirmed:
+      return "the leader awaits confirmation by the next decision";
     case MergeVerdict::kMerge:
       return "merge";
   }
@@ -43,7 +45,7 @@ const char* ToString(MergeVerdict v) {
 
 Status MergeRuleConfig::Validate() const {
   if (!(min_agreement_m > 0) || !(min_constraint_m > 0) || !(accept_conflict_m >= 0) ||
-      !(refute_conflict_m >= accept_conflict_m) || !(undo_conflict_m >= refute_conflict_m) || !(min_rival_constraint_m > 0) || !(margin_ratio >= 1) ||
+      !(refute_conflict_m >= accept_conflict_m) || !(undo_conflict_m >= refute_conflict_m) || confirmations < 1 || !(conflict_per_agreement >= 0) || !(min_rival_constraint_m > 0) || !(margin_ratio >= 1) ||
       !(margin_m >= 0) || !(symmetric_margin_ratio >= margin_ratio)) {
     return Error{Errc::kInvalidConfig,
                  "merge rule: positive evidence thresholds, accept <= refute, margins >= 1 and ordered"};
@@ -126,7 +128,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
       out.verdict = MergeVerdict::kInsufficient;
       return out;
     }
-    if (L.conflict_m() > c.accept_conflict_m) {
+    if (L.conflict_m() > c.AcceptLimit(L)) {
       out.verdict = MergeVerdict::kConflicted;
       return out;
     }

@@ -19,17 +19,6 @@ constexpr std::size_t kDescriptorHeaderV1 = 4 + 1 + 2 + 4 + 4 + 1 + 1 + 4;  // 2
 constexpr std::size_t kDescriptorHeader = kDescriptorHeaderV1 + 1;         // 22
 constexpr std::size_t kCloudHeader = 4 + 1 + 1 + 2 + 4 + 4 + 4 + 4;       // 24
 
-void PutF32(std::uint8_t* p, float f) {
-  std::uint32_t u;
-  std::memcpy(&u, &f, 4);
-  WriteU32Le(p, u);
-}
-float GetF32(const std::uint8_t* p) {
-  const std::uint32_t u = ReadU32Le(p);
-  float f;
-  std::memcpy(&f, &u, 4);
-  return f;
-}
 bool MagicIs(std::span<const std::uint8_t> b, const char* m) {
   return std::memcmp(b.data(), m, 4) == 0;
 }
@@ -67,7 +56,7 @@ Expected<std::size_t> EncodeRoomDescriptor(const RoomDescriptorHeader& h,
   WriteU32Le(p + 11, h.version);
   p[15] = static_cast<std::uint8_t>(d.rings());
   p[16] = static_cast<std::uint8_t>(d.sectors());
-  PutF32(p + 17, d.max_radius_m());
+  WriteF32Le(p + 17, d.max_radius_m());
   // The finest whole-centimetre step at which the tallest cell fits 255 units (20 m at most).
   float tallest = 0;
   for (int r = 0; r < d.rings(); ++r)
@@ -101,7 +90,7 @@ Expected<RoomDescriptorHeader> DecodeRoomDescriptor(std::span<const std::uint8_t
   h.room = ReadU32Le(&bytes[7]);
   h.version = ReadU32Le(&bytes[11]);
   const int rings = bytes[15], sectors = bytes[16];
-  const float radius = GetF32(&bytes[17]);
+  const float radius = ReadF32Le(&bytes[17]);
   if (rings < 1 || sectors < 1 || rings > ScanContext::kMaxRings ||
       sectors > ScanContext::kMaxSectors) {
     return Error{Errc::kMalformed, "room descriptor: rings or sectors out of range"};
@@ -164,13 +153,13 @@ Expected<std::size_t> EncodeRoomCloud(const RoomCloudHeader& h,
   WriteU16Le(p + 6, h.robot);
   WriteU32Le(p + 8, h.room);
   WriteU32Le(p + 12, h.version);
-  PutF32(p + 16, h.step_m);
+  WriteF32Le(p + 16, h.step_m);
   WriteU32Le(p + 20, static_cast<std::uint32_t>(points.size()));
   std::size_t at = kCloudHeader;
   for (const Eigen::Vector3f& q : points) {
     for (int k = 0; k < 3; ++k) {
       if (h.encoding == CloudEncoding::kFloat32) {
-        PutF32(p + at, q[k]);
+        WriteF32Le(p + at, q[k]);
         at += 4;
       } else if (h.encoding == CloudEncoding::kQuantised16) {
         const float units = std::round(q[k] / h.step_m);
@@ -203,7 +192,7 @@ Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
   h.robot = ReadU16Le(&bytes[6]);
   h.room = ReadU32Le(&bytes[8]);
   h.version = ReadU32Le(&bytes[12]);
-  h.step_m = GetF32(&bytes[16]);
+  h.step_m = ReadF32Le(&bytes[16]);
   const std::size_t count = ReadU32Le(&bytes[20]);
   if (h.encoding != CloudEncoding::kFloat32 && !(h.step_m > 0 && std::isfinite(h.step_m))) {
     return Error{Errc::kMalformed, "room cloud: bad quantisation step"};
@@ -217,7 +206,7 @@ Expected<RoomCloudHeader> DecodeRoomCloud(std::span<const std::uint8_t> bytes,
     Eigen::Vector3f q;
     for (int k = 0; k < 3; ++k) {
       if (h.encoding == CloudEncoding::kFloat32) {
-        q[k] = GetF32(&bytes[at]);
+        q[k] = ReadF32Le(&bytes[at]);
         at += 4;
       } else if (h.encoding == CloudEncoding::kQuantised16) {
         q[k] = static_cast<float>(static_cast<std::int16_t>(ReadU16Le(&bytes[at]))) * h.step_m;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 
 namespace msgraphs {
 
@@ -20,6 +21,18 @@ inline void WriteU16Le(std::uint8_t* p, std::uint16_t v) {
 }
 inline void WriteU32Le(std::uint8_t* p, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFu);
+}
+/// IEEE-754 binary32, little-endian (the collab messages' coordinates).
+inline void WriteF32Le(std::uint8_t* p, float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, 4);
+  WriteU32Le(p, u);
+}
+inline float ReadF32Le(const std::uint8_t* p) {
+  const std::uint32_t u = ReadU32Le(p);
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
 }
 
 }  // namespace msgraphs

@@ -12,7 +12,8 @@
 //   to one of y's walls, away from y's own openings; counted when they cover at least
 //   `door_solid_share` of the opening (a correct transform leaves the jambs, a fraction of it,
 //   and a door y saw only edge-on may look closed in part), and when y saw no opening of its
-//   own on that line within `max_opening_m` (then both saw one door, its extent differently).
+//   own on that line within `max_opening_m` (then both saw one door, its extent differently);
+//   openings narrower than `min_door_m` do not count.
 // Both are lengths in metres; the merge rule compares them with its thresholds (merge_rule.hpp).
 // No allocation.
 #pragma once
@@ -40,6 +41,9 @@ struct FreeSpaceConflictConfig {
   double door_solid_share = 0.8;
   double door_wall_distance_m = 0.3;  ///< an occupied cell this close to a wall line is that wall
   double max_opening_m = 3.0;         ///< the widest doorway (building codes: double doors 2.4 m)
+  /// An opening narrower than the narrowest door (building codes: 0.8 m clear) is no evidence
+  /// on a solid wall: a gap between returns, a door seen edge-on.
+  double min_door_m = 0.8;
   Status Validate() const;
 };
 

@@ -5,7 +5,8 @@
 //
 // Given every hypothesis of the alignment search (alignment_search.hpp), best wall agreement
 // first, with its conflicts in both directions (free_space_conflict.hpp):
-// 1. A hypothesis with more than `refute_conflict_m` of conflict is refuted: one robot mapped a
+// 1. A hypothesis with more than `refute_conflict_m` of conflict (or a share of its agreement:
+//    conflict_per_agreement) is refuted: one robot mapped a
 //    wall (or saw through an opening) where the other saw through (or saw a solid wall).
 // 2. The leader is the first hypothesis not refuted. It must agree along at least
 //    `min_agreement_m` of wall and `min_constraint_m` in its weakest direction (two directions
@@ -25,7 +26,7 @@
 //    contradicted, the likeliest explanation is an error in the free space or the maps (the
 //    true transform refuted by an artefact), not that a much weaker alternative is true; and a
 //    weaker alternative is what a repeated structure (a mirrored wing) offers.
-// Then: merge with the leader. A merged pair is kept while its hypothesis has at most
+// Then: merge with the leader, once it has led `confirmations` consecutive decisions. A merged pair is kept while its hypothesis has at most
 // `undo_conflict_m` of conflict and no rival beats it by the margin (hysteresis: accept at
 // accept_conflict_m, refute others beyond refute_conflict_m, undo a merge beyond
 // undo_conflict_m).
@@ -38,6 +39,7 @@
 // repeats, (c) fails, because the true transform then stands as a rival.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 
@@ -67,8 +69,28 @@ struct MergeRuleConfig {
   /// Slides of the leader along each principal direction probed each way (rule 4); 0: none. The
   /// probes are 2 agreement offsets apart, wider when b's extent needs more than this many.
   std::size_t max_slide_probes = 128;
+  /// A new merge needs the same leader in this many consecutive decisions (each one on new
+  /// data: the search and the rule run when a map or a free space changed), so that what the
+  /// robots see next can refute it before it is acted on: two robots that just left identical
+  /// rooms agree perfectly on the wrong copy until one of them sees past it. 1: at once.
+  std::uint32_t confirmations = 2;
+  /// The conflict limits grow with the evidence: each is the larger of its value above and
+  /// this share of the hypothesis' agreement (times 1, 2, 4 for accept, refute, undo). Maps a
+  /// few centimetres off and wall extents that overshoot leave conflict in proportion to what
+  /// was mapped (1-2 m against 200-400 m of agreeing wall after 5 minutes); a wrong transform
+  /// lays whole walls across free space, metres for every room it misplaces.
+  double conflict_per_agreement = 0.0025;
   FreeSpaceConflictConfig conflict;
   Status Validate() const;
+  double AcceptLimit(const Hypothesis& h) const {
+    return std::max(accept_conflict_m, conflict_per_agreement * h.agreement.agreement_m);
+  }
+  double RefuteLimit(const Hypothesis& h) const {
+    return std::max(refute_conflict_m, 2 * conflict_per_agreement * h.agreement.agreement_m);
+  }
+  double UndoLimit(const Hypothesis& h) const {
+    return std::max(undo_conflict_m, 4 * conflict_per_agreement * h.agreement.agreement_m);
+  }
 };
 
 enum class MergeVerdict : std::uint8_t {
@@ -82,6 +104,9 @@ enum class MergeVerdict : std::uint8_t {
   /// The strongest evidence (a hypothesis beating the leader by the margin) is refuted: either
   /// the free space is in error or the maps disagree; a weaker alternative is not trusted.
   kContradicted,
+  /// The rule would merge, but this leader has not yet led `confirmations` consecutive
+  /// decisions (the session's bookkeeping, collab_merge.cpp).
+  kUnconfirmed,
   kMerge,
 };
 const char* ToString(MergeVerdict verdict);
