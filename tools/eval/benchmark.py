@@ -54,7 +54,7 @@ def plan(index, ci):
     """The mission of this index: everything the simulator is told."""
     rng = random.Random(7919 * index + 17)
     style, symmetry = KINDS[index % len(KINDS)]
-    # 2 to 5 robots, 2-3 most often; 120-180 s: 40 missions fit 60 minutes on 2 cores.
+    # 2 to 5 robots, 2-3 most often; 120-180 s: 40 missions in about an hour on 2 cores.
     robots = 2 if ci else rng.choice([2, 2, 3, 3, 4, 5])
     duration = 120 if ci else rng.choice([120, 150, 180])
     mission = {
