@@ -77,8 +77,11 @@ done
 duration=180; pace=recorded; speed=4; cap_kbps=0
 [[ $mode == cap20 ]] && cap_kbps=20
 [[ $mode == cut30 ]] && speed=2
+# Without Spot's gait: this test is about the link (discovery, loss, a cut, a budget). With the
+# gait the office's free space carries conflict artefacts of about 1.2 % of the agreement after
+# 2 minutes, beyond the merge rule's undo limit (docs/multi-robot.md, "Noticed, left alone").
 "$sim" --world "$world" --out "$work/run" --robots 2 --duration-s "$duration" --seed 1 \
-  --shared-rooms 2 > /dev/null || exit 1
+  --shared-rooms 2 --gait off > /dev/null || exit 1
 conf() {  # robot, own address, peers
   cat <<CONF
 [robot]

@@ -113,8 +113,10 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
     d = DecideMerge(in, search, config.merge, p.merged ? &p.T_merge : nullptr);
   }
   const double same_m = config.search.same_distance_m, same_rad = config.search.same_angle_rad;
-  // Confirmation: a new merge, or a move to another transform, needs the same leader in
-  // `confirmations` consecutive decisions; the current merge refined on new walls does not.
+  // Confirmation: a new merge, or a move to another transform, needs the same leader to win
+  // `confirmations` decisions with no other leader winning in between (decisions that merge
+  // nothing, e.g. an exchange on which an artefact refuted it, do not reset the count); the
+  // current merge refined on new walls needs none.
   if (d.verdict == MergeVerdict::kMerge && !d.keeping) {
     if (p.pending_count > 0 && SameTransform(d.leader.T_a_b, p.pending_T, 2 * same_m, 2 * same_rad))
       ++p.pending_count;
@@ -122,8 +124,6 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
       p.pending_count = 1;
     p.pending_T = d.leader.T_a_b;
     if (p.pending_count < config.merge.confirmations) d.verdict = MergeVerdict::kUnconfirmed;
-  } else if (d.verdict != MergeVerdict::kMerge) {
-    p.pending_count = 0;
   }
   p.decision = d;
 
