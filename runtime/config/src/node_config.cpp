@@ -287,6 +287,7 @@ bool ParseNodeConfig(const std::string& text,
 
   r.Path("checkpoint", "dir", c.checkpoint_dir);
   r.Number("checkpoint", "sync_period_s", 0.1, 3600, c.checkpoint_sync_s);
+  r.Number("checkpoint", "max_speed_mps", 0.1, 20, c.relocalise_max_speed_mps);
 
   r.Path("output", "dir", c.output_dir);
   r.CheckAllUsed();

@@ -96,19 +96,25 @@ Node::Impl::Relocalising Node::Impl::RelocaliseOn(const ScanSlot& scan) {
   }
   // Where to look: from where the journal stopped, along the motion the robot had then (its
   // last half second), for 1.5 times the time since (the robot may have slowed or stopped).
-  core::RelocaliseSearch search;
-  search.T_odom_from = T_old_last;
-  search.T_odom_to = T_old_last;
-  const double since_s = scan.end_s - old_last_stamp_s;
-  if (auto before = mapper.odometry().At(old_last_stamp_s - 0.5); before && since_s > 0) {
-    const Eigen::Isometry3d step = before->T_odom_base.inverse() * T_old_last;
-    const double k = std::min(1.5 * since_s / 0.5, 60.0);
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();  // per half second, when it stopped
+  if (auto before = mapper.odometry().At(old_last_stamp_s - 0.5)) {
+    step = before->T_odom_base.inverse() * T_old_last;
+  }
+  // The last half second's motion kept for `seconds`, level (the base rocks).
+  const auto kept_on = [&](double seconds) {
+    const double k = std::clamp(seconds / 0.5, 0.0, 60.0);
     const double yaw = std::atan2(step.linear()(1, 0), step.linear()(0, 0));
     Eigen::Isometry3d ahead = Eigen::Isometry3d::Identity();
     ahead.linear() = Eigen::AngleAxisd(k * yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     ahead.translation() << k * step.translation().x(), k * step.translation().y(), 0;
-    search.T_odom_to = T_old_last * ahead;
-  }
+    return T_old_last * ahead;
+  };
+  core::RelocaliseSearch search;
+  search.T_odom_from = T_old_last;
+  const double since_s = scan.end_s - old_last_stamp_s;
+  search.T_odom_to = kept_on(1.5 * since_s);
+  // Failing that, anywhere the robot could have walked to at its top speed.
+  search.reach_m = config.relocalise_max_speed_mps * std::max(since_s, 0.0);
   const SteadyTime t0 = platform::SteadyNow();
   core::LidarScanView view{scan.points, scan.time_offset_s, scan.start_s, scan.end_s};
   auto found = mapper.Relocalise(view, at_start->T_odom_base, at_end->T_odom_base, search);
@@ -119,17 +125,23 @@ Node::Impl::Relocalising Node::Impl::RelocaliseOn(const ScanSlot& scan) {
     const Eigen::Isometry3d moved = T_old_last.inverse() * T_odom_base_now;
     std::printf(
         "relocalised after the restart: the robot moved %.2f m and turned %.1f deg while the node "
-        "was down (%.1f s); fitness %.4f m2, %zu seeds scored, %zu registered, %.2f s\n",
+        "was down (%.1f s); fitness %.4f m2, %zu seeds scored%s, %zu registered, %.2f s\n",
         moved.translation().head<2>().norm(),
         Eigen::AngleAxisd(moved.linear()).angle() * 180.0 / 3.14159265358979, since_s,
-        found->fitness_m2, found->candidates, found->registrations, took_s);
+        found->fitness_m2, found->candidates,
+        found->wide ? " (off the predicted path: searched within reach)" : "", found->registrations,
+        took_s);
   } else {
-    // Nothing aligned (an empty map, a scan of a place not mapped yet): as if the robot had
-    // stood still; scan matching then takes up what it moved within max_correction_m.
-    T_odom_base_now = T_old_last * new_odometry.pose(0).inverse() * at_end->T_odom_base;
-    std::printf("WARNING: relocalisation after the restart failed (%s); resuming from the last "
-                "journaled pose\n",
-                found.error().detail);
+    // Nothing aligned (a place not mapped yet, or one the map saw only from afar): the robot
+    // is taken to have kept its motion through the downtime (a walking robot was most likely
+    // still walking; one that stood still had no motion to keep); scan matching then takes
+    // up the rest within max_correction_m.
+    const double down_s = std::max(0.0, new_odometry.stamp(0) - old_last_stamp_s);
+    T_odom_base_now = kept_on(down_s) * new_odometry.pose(0).inverse() * at_end->T_odom_base;
+    std::printf("WARNING: relocalisation after the restart failed (%s); resuming %.1f s after "
+                "the last journaled pose with the motion the robot had then (%.2f m)\n",
+                found.error().detail, since_s,
+                (T_old_last.inverse() * T_odom_base_now).translation().head<2>().norm());
   }
   std::fflush(stdout);
   T_odom_fix = T_odom_base_now * at_end->T_odom_base.inverse();

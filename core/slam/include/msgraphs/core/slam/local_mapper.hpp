@@ -155,7 +155,10 @@ struct LocalMapperStats {
 /// Where to look for the robot after its odometry integration restarted (Relocalise): on the
 /// segment between two poses of this mapper's odometry frame (where it stopped, where it would
 /// be had it kept its speed), one step beyond each end, up to `lateral_m` to either side and
-/// `yaw_rad` either way of the heading interpolated along it.
+/// `yaw_rad` either way of the heading interpolated along it. When nothing there aligns and
+/// `reach_m` > 0, anywhere within `reach_m` of where it stopped (the robot's top speed times the
+/// time the node was down: it may have turned a corner, or walked back), nearest first, at
+/// every heading of the search.
 struct RelocaliseSearch {
   Eigen::Isometry3d T_odom_from = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_odom_to = Eigen::Isometry3d::Identity();
@@ -169,6 +172,9 @@ struct RelocaliseSearch {
   /// many as the local map holds (the robot may have walked beyond the last few keyframes).
   double map_radius_m = 10.0;
   std::size_t registrations = 6;  ///< the best-scored seeds registered (at most 8)
+  double reach_m = 0;  ///< 0: the segment only
+  /// Seeds scored within reach; the farthest rings are left out beyond.
+  std::size_t max_reach_candidates = 400000;
 };
 
 struct Relocalisation {
@@ -176,6 +182,7 @@ struct Relocalisation {
   double fitness_m2 = 0;
   std::size_t candidates = 0;     ///< seeds scored
   std::size_t registrations = 0;  ///< of them registered
+  bool wide = false;              ///< found by the search within reach, not on the segment
 };
 
 class LocalMapper {
@@ -243,6 +250,8 @@ class LocalMapper {
                   const Eigen::Isometry3d& T_odom_end);
   bool BuildLocalMap(std::uint32_t last);
   bool BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t> keyframes);
+  bool BuildMapNear(const Eigen::Vector2d& a_map, const Eigen::Vector2d& b_map, double radius_m);
+  double SeedScore(const Eigen::Isometry3d& T_last_seed) const;
   Matrix6d OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const;
   void ExtractPlanes();
 

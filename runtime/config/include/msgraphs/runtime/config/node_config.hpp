@@ -89,6 +89,9 @@ struct NodeConfig {
   // [checkpoint]
   std::string checkpoint_dir;      ///< empty: no checkpoint; else the journal lives here
   double checkpoint_sync_s = 5.0;  ///< fsync period (power-cut safety)
+  /// The robot's top speed: after a restart, how far it can have walked while the node was
+  /// down (the relocalisation's reach). Spot's is 1.6 m/s.
+  double relocalise_max_speed_mps = 1.6;
 
   // [output]
   std::string output_dir;  ///< empty: no files at exit
