@@ -40,7 +40,9 @@ std::optional<double> Intersect(const Eigen::Vector2d& o, const Eigen::Vector2d&
 }
 
 // Scans from each position: 720 horizontal rays at 1 m height, plus floor points.
-void Scan(FreeSpaceGrid& grid, const Plan& plan, const std::vector<Eigen::Vector2d>& positions) {
+// With `follow`, the grid window follows the sensor first (as the mapper does).
+void Scan(FreeSpaceGrid& grid, const Plan& plan, const std::vector<Eigen::Vector2d>& positions,
+          bool follow = false) {
   std::vector<Eigen::Vector3f> points;
   for (const Eigen::Vector2d& local : positions) {
     const Eigen::Vector2d o = plan.R(local);
@@ -57,6 +59,7 @@ void Scan(FreeSpaceGrid& grid, const Plan& plan, const std::vector<Eigen::Vector
       const Eigen::Vector2d f = o + d * std::min(best - 0.1, 3.0);
       points.emplace_back(static_cast<float>(f.x()), static_cast<float>(f.y()), 0.0f);
     }
+    if (follow) grid.Follow(o.cast<float>());
     grid.Integrate(Eigen::Vector3f(static_cast<float>(o.x()), static_cast<float>(o.y()), 0.8f), points, 0.0f);
   }
 }
@@ -208,6 +211,69 @@ TEST(Rooms, EmptyGridsAndRoomlessInputGiveNothingAndNoCrash) {
   FreeSpaceGridConfig bad;
   bad.resolution_m = 0;
   EXPECT_EQ(grid.Init(bad).error().code, Errc::kInvalidConfig);
+}
+
+// A building longer than the grid: the window follows the robot down it, what stays inside
+// keeps its cells, and rooms at the far end are found as they would be in a grid that held all.
+TEST(Rooms, TheGridWindowFollowsTheRobotThroughABuildingLargerThanIt) {
+  TwoRoomsAndCorridor near(0), far(0);
+  const Eigen::Vector2d shift(40, 0);  // the same two rooms and corridor 40 m on
+  for (auto& f : far.plan.faces) {
+    f.a += shift;
+    f.b += shift;
+  }
+  for (auto& w : far.walls) {
+    w.a += shift;
+    w.b += shift;
+    w.d = -w.normal.dot(w.a);
+  }
+  FreeSpaceGridConfig gc;
+  gc.width = gc.height = 240;  // 24 m: less than the 52 m building
+  gc.origin_m = {-6, -6};
+  gc.max_range_m = 8;
+  FreeSpaceGrid grid;
+  ASSERT_TRUE(grid.Init(gc));
+  Scan(grid, near.plan, {{1.5, 1.5}, {4.5, 3.5}}, true);
+  EXPECT_EQ(grid.moves(), 0u) << "the sensor is well inside";
+  // A step that moves the window: cells that stay inside keep their state where they are.
+  const Eigen::Vector2d probe(3.0, 2.5);  // free, in the first room
+  int px = 0, py = 0;
+  ASSERT_TRUE(grid.ToCell(probe, px, py));
+  const FreeSpaceGrid::Cell before = grid.state(px, py);
+  ASSERT_EQ(before, FreeSpaceGrid::Cell::kFree);
+  {
+    test::AllocationScope scope;
+    EXPECT_TRUE(grid.Follow(Eigen::Vector2f(13.0f, 2.0f)));
+    EXPECT_EQ(scope.allocations(), 0u);
+  }
+  EXPECT_EQ(grid.moves(), 1u);
+  EXPECT_NE(grid.origin_m().x(), -6.0f);
+  EXPECT_FLOAT_EQ(std::fmod(grid.origin_m().x() + 6.0f, 4.0f), 0.0f) << "whole steps of 40 cells";
+  ASSERT_TRUE(grid.ToCell(probe, px, py));
+  EXPECT_EQ(grid.state(px, py), before);
+  EXPECT_FALSE(grid.Follow(Eigen::Vector2f(13.0f, 2.0f))) << "inside now: no move";
+  // Down the corridor to the far rooms: the window follows; the near rooms leave it.
+  Scan(grid, near.plan, {{11, 6.2}}, true);
+  Scan(grid, far.plan, {{41.5, 1.5}, {44.5, 3.5}, {43, 2.5}, {47.5, 1.5}, {50.5, 3.5}, {49, 2.5},
+                        {41, 6.2}, {46, 6.2}, {51, 6.2}}, true);
+  EXPECT_GE(grid.moves(), 2u);
+  EXPECT_FALSE(grid.ToCell(probe, px, py)) << "the first room is behind the window now";
+  RoomSegmenter segmenter;
+  ASSERT_TRUE(segmenter.Init(240, 240, 64, 64));
+  BoundedVector<RoomRegion> regions(64);
+  ASSERT_TRUE(segmenter.Segment(grid, {}, regions));
+  BoundedVector<DetectedRoom> rooms(16);
+  ASSERT_TRUE(segmenter.DetectRooms(grid, regions.span(), far.walls, {}, rooms));
+  int found = 0;
+  for (const DetectedRoom& r : rooms) {
+    if (r.kind != RoomKind::kRoom) continue;
+    EXPECT_NEAR(r.centre.y(), 2.5, 0.05);
+    EXPECT_NEAR(std::fabs(r.centre.x() - 46.0), 3.0, 0.05) << "the far rooms, in map coordinates";
+    ++found;
+  }
+  EXPECT_EQ(found, 2);
+  // Not finite: nothing moves.
+  EXPECT_FALSE(grid.Follow(Eigen::Vector2f(std::nanf(""), 0.0f)));
 }
 
 TEST(Rooms, SegmentingAndDetectingAllocateNothing) {

@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 
 namespace msgraphs::core {
 
 Status FreeSpaceGridConfig::Validate() const {
   if (!(resolution_m >= 0.02f && resolution_m <= 1.0f) || width < 8 || height < 8 || width > 8192 || height > 8192 ||
-      !origin_m.allFinite() || !(obstacle_max_height_m > obstacle_min_height_m) || !(max_range_m > 0)) {
+      !origin_m.allFinite() || !(obstacle_max_height_m > obstacle_min_height_m) || !(max_range_m > 0) ||
+      follow_step_cells < 1) {
     return Error{Errc::kInvalidConfig, "free space grid: resolution 0.02..1 m, 8..8192 cells per side, heights ordered"};
   }
   return Ok();
@@ -23,6 +25,9 @@ Status FreeSpaceGrid::Init(const FreeSpaceGridConfig& config) {
   occupied_.assign(n, 0);
   clear_low_.assign(n, 0);
   outside_ = 0;
+  moves_ = 0;
+  origin0_m_ = config.origin_m;
+  moved_cells_.setZero();
   return Ok();
 }
 
@@ -89,6 +94,52 @@ void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool
       y0 += sy;
     }
   }
+}
+
+void FreeSpaceGrid::Shift(std::vector<std::uint16_t>& cells, int dx, int dy) const {
+  // new(x, y) = old(x + dx, y + dy), zero where that is outside. Rows are visited in the order
+  // that reads each source row before it is overwritten.
+  const int w = config_.width, h = config_.height;
+  const int keep = std::max(0, w - std::abs(dx));
+  for (int i = 0; i < h; ++i) {
+    const int y = dy >= 0 ? i : h - 1 - i;
+    std::uint16_t* row = cells.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    const int src_y = y + dy;
+    if (src_y < 0 || src_y >= h || keep == 0) {
+      std::fill(row, row + w, std::uint16_t{0});
+      continue;
+    }
+    const std::uint16_t* src = cells.data() + static_cast<std::size_t>(src_y) * static_cast<std::size_t>(w);
+    std::memmove(row + std::max(0, -dx), src + std::max(0, dx), static_cast<std::size_t>(keep) * sizeof(std::uint16_t));
+    if (dx > 0) std::fill(row + keep, row + w, std::uint16_t{0});
+    if (dx < 0) std::fill(row, row - dx, std::uint16_t{0});
+  }
+}
+
+bool FreeSpaceGrid::Follow(const Eigen::Vector2f& sensor_m) {
+  if (!sensor_m.allFinite()) return false;
+  const float r = config_.resolution_m;
+  const float margin_m =
+      std::min(config_.max_range_m, 0.25f * r * static_cast<float>(std::min(config_.width, config_.height)));
+  const Eigen::Vector2f low = sensor_m - config_.origin_m;
+  const Eigen::Vector2f high = Eigen::Vector2f(r * static_cast<float>(config_.width), r * static_cast<float>(config_.height)) - low;
+  if (low.minCoeff() >= margin_m && high.minCoeff() >= margin_m) return false;
+  // The shift that centres the sensor, rounded to whole steps (a far jump clears the grid).
+  const auto steps = [&](float offset_m, int cells) {
+    const double shift_cells = static_cast<double>(offset_m / r) - 0.5 * cells;
+    const int step = config_.follow_step_cells;
+    const double s = std::round(shift_cells / step) * step;
+    return static_cast<int>(std::clamp(s, -4.0 * cells, 4.0 * cells));
+  };
+  const int dx = steps(low.x(), config_.width), dy = steps(low.y(), config_.height);
+  if (dx == 0 && dy == 0) return false;
+  Shift(free_, dx, dy);
+  Shift(occupied_, dx, dy);
+  Shift(clear_low_, dx, dy);
+  moved_cells_ += Eigen::Vector2i(dx, dy);  // summed in cells: no rounding drift over many moves
+  config_.origin_m = origin0_m_ + moved_cells_.cast<float>() * r;
+  ++moves_;
+  return true;
 }
 
 void FreeSpaceGrid::Integrate(const Eigen::Vector3f& sensor, std::span<const Eigen::Vector3f> points, float floor_z) {

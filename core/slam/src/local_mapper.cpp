@@ -297,7 +297,9 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     world_points_.clear();
     for (const Eigen::Vector3f& p : filtered_)
       static_cast<void>(world_points_.try_push_back(T * p));
-    grid_.Integrate((T_map_base * config_.T_base_lidar).translation().cast<float>(),
+    const Eigen::Vector3f sensor_map = (T_map_base * config_.T_base_lidar).translation().cast<float>();
+    if (config_.grid_follows_robot) static_cast<void>(grid_.Follow(sensor_map.head<2>()));
+    grid_.Integrate(sensor_map,
                     world_points_.span(),
                     static_cast<float>(T_map_base.translation().z() - config_.base_height_m));
   }

@@ -233,14 +233,16 @@ bool ParseNodeConfig(const std::string& text,
   r.Float("mapping", "max_range_m", 1.0, 120.0, c.mapper.max_range_m);
   r.Integer("mapping", "max_keyframes", 16, 1000000, c.mapper.graph.max_keyframes);
   r.Integer("mapping", "cloud_store_points", 100000, 100000000, c.mapper.cloud_store_points);
-  // The free-space grid: a square centred on the start, at its resolution (memory grows with
-  // the square of the extent: 1024 x 1024 cells at the default).
+  // The free-space grid: a square window, first centred on the start, that follows the robot
+  // (grid_follows_robot), at its resolution (memory grows with the square of the extent:
+  // 1024 x 1024 cells at the default).
   double grid_half_extent_m =
       0.5 * static_cast<double>(c.mapper.grid.width) * static_cast<double>(c.mapper.grid.resolution_m);
   r.Number("mapping", "grid_half_extent_m", 10.0, 1000.0, grid_half_extent_m);
   const int cells = static_cast<int>(std::ceil(2.0 * grid_half_extent_m / static_cast<double>(c.mapper.grid.resolution_m)));
   c.mapper.grid.width = c.mapper.grid.height = cells;
   c.mapper.grid.origin_m = Eigen::Vector2f::Constant(-0.5f * static_cast<float>(cells) * c.mapper.grid.resolution_m);
+  r.Bool("mapping", "grid_follows_robot", c.mapper.grid_follows_robot);
 
   int mode = 3;
   r.Choice("collab", "mode", kModes, mode);

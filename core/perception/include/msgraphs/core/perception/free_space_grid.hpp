@@ -4,8 +4,10 @@
 // obstacle height band mark their cell occupied. Rays that descend from the sensor (towards a
 // point below it) also mark the cells they cross clear below the sensor: no obstacle as tall
 // as the sensor stands there, since it would have stopped the ray; rays that pass over a box
-// towards the ceiling say nothing of that kind (`clear_below_sensor`). Fixed size and origin from configuration;
-// points outside the grid are counted and ignored. Integrate allocates nothing.
+// towards the ceiling say nothing of that kind (`clear_below_sensor`). Fixed size from configuration;
+// points outside the grid are counted and ignored. The grid is a window that can follow the robot
+// (Follow): a building larger than the window keeps the free space around the robot, the rooms
+// already found stay in the graph. Integrate and Follow allocate nothing.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,6 +27,9 @@ struct FreeSpaceGridConfig {
   float obstacle_min_height_m = 0.25f;  ///< above the floor: below is floor and clutter-free space
   float obstacle_max_height_m = 2.0f;   ///< above: ceiling, lamps; they do not block walking
   float max_range_m = 25.0f;
+  /// Cells the window moves by, at least (a whole number of free-space summary cells keeps the
+  /// summary's cells on the same places in the map).
+  int follow_step_cells = 40;
 
   Status Validate() const;
 };
@@ -51,16 +56,27 @@ class FreeSpaceGrid {
   int height() const { return config_.height; }
   float resolution() const { return config_.resolution_m; }
   std::uint64_t outside() const { return outside_; }
+  /// Moves the window (whole cells, by multiples of follow_step_cells) so that `sensor_m` is at
+  /// its centre, once the sensor is nearer an edge than its range (or a quarter of the window,
+  /// if that is less): what it sees then stays inside. Cells that leave the window are
+  /// forgotten. True when it moved.
+  bool Follow(const Eigen::Vector2f& sensor_m);
+  std::uint64_t moves() const { return moves_; }
+  Eigen::Vector2f origin_m() const { return config_.origin_m; }
   void Clear();
 
  private:
   void Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending);
+  void Shift(std::vector<std::uint16_t>& cells, int dx, int dy) const;
 
   FreeSpaceGridConfig config_;
   std::vector<std::uint16_t> free_;
   std::vector<std::uint16_t> occupied_;
   std::vector<std::uint16_t> clear_low_;
   std::uint64_t outside_ = 0;
+  std::uint64_t moves_ = 0;
+  Eigen::Vector2f origin0_m_ = Eigen::Vector2f::Zero();  // the configured origin
+  Eigen::Vector2i moved_cells_ = Eigen::Vector2i::Zero();  // since: origin = origin0 + moved * res
 };
 
 }  // namespace msgraphs::core

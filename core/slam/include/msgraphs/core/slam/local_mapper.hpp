@@ -93,6 +93,10 @@ struct LocalMapperConfig {
   PlaneAssociationConfig association;
   RoomMapperConfig rooms;
   FreeSpaceGridConfig grid;
+  /// The free-space grid is a window that moves with the robot (FreeSpaceGrid::Follow): in a
+  /// building larger than the window, rooms far from the start are still found. Off: a fixed
+  /// window around the start (free space beyond is counted in grid().outside()).
+  bool grid_follows_robot = true;
   LoopClosureConfig loops;
   /// Fitness leaves out points farther than 1 m from the map: a keyframe sees new space that
   /// the local map cannot contain, and that is not misalignment.
