@@ -116,12 +116,19 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
   // Confirmation: a new merge, or a move to another transform, needs the same leader to win
   // `confirmations` decisions with no other leader winning in between (decisions that merge
   // nothing, e.g. an exchange on which an artefact refuted it, do not reset the count); the
-  // current merge refined on new walls needs none.
+  // current merge refined on new walls needs none. A confirmation must come from a newer graph
+  // (ours or the peer's): one exchange brings the peer's graph, its free space and its room
+  // matches as separate messages, each a decision, and three wrong merges of the benchmark were
+  // "confirmed" by the second decision of the exchange that proposed them.
   if (d.verdict == MergeVerdict::kMerge && !d.keeping) {
-    if (p.pending_count > 0 && SameTransform(d.leader.T_a_b, p.pending_T, 2 * same_m, 2 * same_rad))
-      ++p.pending_count;
-    else
+    const bool newer = own_version != p.pending_own || p.graph.version != p.pending_peer;
+    if (p.pending_count > 0 && SameTransform(d.leader.T_a_b, p.pending_T, 2 * same_m, 2 * same_rad)) {
+      if (newer) ++p.pending_count;
+    } else {
       p.pending_count = 1;
+    }
+    p.pending_own = own_version;
+    p.pending_peer = p.graph.version;
     p.pending_T = d.leader.T_a_b;
     if (p.pending_count < config.merge.confirmations) d.verdict = MergeVerdict::kUnconfirmed;
   }

@@ -99,6 +99,8 @@ struct CollabSession::Impl {
     // consecutive decisions it led.
     PlanarTransform pending_T;
     std::uint32_t pending_count = 0;
+    // The graphs (own, the peer's) it last led on: only a decision on a newer graph confirms.
+    std::uint32_t pending_own = 0, pending_peer = 0;
     std::uint32_t solved_version = 0;  // its graph's version at the last solve
     Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();
     CollabPeerStats stats;
