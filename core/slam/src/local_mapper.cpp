@@ -47,7 +47,7 @@ Status LocalMapperConfig::Validate() const {
       !(max_correction_rad > 0) || !(odometry_sigma_min_m > 0) ||
       !(odometry_rotation_sigma_min > 0) || !(odometry_sigma_per_m >= 0) ||
       !(odometry_rotation_sigma_per_m >= 0) || !(odometry_gap_inflation >= 1) ||
-      !(odometry_gate_chi2 >= 0) ||
+      !(odometry_gate_chi2 >= 0) || !(motion_seed_max_age_s >= 0) ||
       room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 || max_plane_priors < 1 ||
       cloud_store_points < max_scan_points || odometry_capacity < 16 || !(odometry_max_gap_s > 0)) {
     return Error{Errc::kInvalidConfig,
@@ -97,6 +97,7 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   floor_members_.Init(config.max_scan_points);
   next_sequence_ = 1;
   have_keyframe_ = false;
+  have_motion_ = false;
   T_map_odom_ = Eigen::Isometry3d::Identity();
   path_m_ = 0;
   keyframes_since_rooms_ = keyframes_since_full_ = 0;
@@ -217,28 +218,35 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   Eigen::Isometry3d T_last_new = delta;
   Matrix6d match_information = Matrix6d::Identity();
   if (have_keyframe_ && BuildLocalMap(last_keyframe_)) {
-    auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_, local_points_.span(),
-                               local_tree_, delta, config_.scan_matching);
-    if (!result || !result->converged) {
-      ++stats_.scan_match_rejected_failed;
-    } else if (result->fitness > config_.scan_match_max_fitness_m2) {
-      ++stats_.scan_match_rejected_fitness;
-    } else if (static_cast<double>(result->correspondences) <
-               config_.scan_match_min_overlap * static_cast<double>(down_.size())) {
-      ++stats_.scan_match_rejected_overlap;
-    } else {
-      const Eigen::Isometry3d correction = delta.inverse() * result->T_target_source;
-      if (correction.translation().norm() > config_.max_correction_m ||
-          Eigen::AngleAxisd(correction.linear()).angle() > config_.max_correction_rad) {
-        ++stats_.scan_match_rejected_diverged;
-      } else {
+    double fitness_m2 = 0;
+    MatchOutcome outcome = MatchFrom(delta, T_last_new, match_information, fitness_m2);
+    // A step whose odometry disagrees with the pace the last match measured may be a slip:
+    // VGICP from a guess 0.4 m off can stop part way and still pass every test, so the motion's
+    // guess is registered too, and the better fit of the two accepted ones kept.
+    Eigen::Isometry3d seed, T_motion;
+    Matrix6d motion_information;
+    double motion_fitness_m2 = 0;
+    if (MotionSeed(delta, scan.end_s, seed) &&
+        MatchFrom(seed, T_motion, motion_information, motion_fitness_m2) == MatchOutcome::kAccepted &&
+        (outcome != MatchOutcome::kAccepted || motion_fitness_m2 < fitness_m2)) {
+      if (outcome == MatchOutcome::kAccepted) ++stats_.scan_match_motion_preferred;
+      ++stats_.scan_match_motion_seeded;
+      outcome = MatchOutcome::kAccepted;
+      T_last_new = T_motion;
+      match_information = motion_information;
+    }
+    switch (outcome) {
+      case MatchOutcome::kAccepted:
         matched = true;
-        T_last_new = result->T_target_source;
-        match_information = InformationFromHessian(result->hessian, config_.scan_match_sigma_m);
         T_map_new = graph_.keyframe_pose(last_keyframe_) * T_last_new;
         ++stats_.scan_match_accepted;
-      }
+        break;
+      case MatchOutcome::kFailed: ++stats_.scan_match_rejected_failed; break;
+      case MatchOutcome::kFitness: ++stats_.scan_match_rejected_fitness; break;
+      case MatchOutcome::kOverlap: ++stats_.scan_match_rejected_overlap; break;
+      case MatchOutcome::kDiverged: ++stats_.scan_match_rejected_diverged; break;
     }
+    if (!matched) T_last_new = delta;
   } else if (have_keyframe_) {
     ++stats_.scan_match_rejected_failed;
   }
@@ -327,12 +335,58 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     static_cast<void>(rooms_.Update(grid_, planes_mapper_, graph_));
   }
   Stage(observer, MapperStage::kRooms);
+  if (matched) {
+    have_motion_ = true;
+    motion_m_ = T_last_new.translation().norm();
+    motion_s_ = scan.end_s - graph_.keyframe_stamp(last_keyframe_);
+    motion_end_s_ = scan.end_s;
+  }
   have_keyframe_ = true;
   last_keyframe_ = id;
   last_odometry_ = T_odom_now;
   T_map_odom_ = graph_.keyframe_pose(id) * T_odom_now.inverse();
   ++stats_.keyframes;
   return ScanOutcome::kKeyframe;
+}
+
+LocalMapper::MatchOutcome LocalMapper::MatchFrom(const Eigen::Isometry3d& T_last_seed,
+                                                 Eigen::Isometry3d& T_last_new,
+                                                 Matrix6d& information, double& fitness_m2) {
+  auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_, local_points_.span(),
+                             local_tree_, T_last_seed, config_.scan_matching);
+  if (!result || !result->converged) return MatchOutcome::kFailed;
+  fitness_m2 = result->fitness;
+  if (result->fitness > config_.scan_match_max_fitness_m2) return MatchOutcome::kFitness;
+  if (static_cast<double>(result->correspondences) <
+      config_.scan_match_min_overlap * static_cast<double>(down_.size())) {
+    return MatchOutcome::kOverlap;
+  }
+  const Eigen::Isometry3d correction = T_last_seed.inverse() * result->T_target_source;
+  if (correction.translation().norm() > config_.max_correction_m ||
+      Eigen::AngleAxisd(correction.linear()).angle() > config_.max_correction_rad) {
+    return MatchOutcome::kDiverged;
+  }
+  T_last_new = result->T_target_source;
+  information = InformationFromHessian(result->hessian, config_.scan_match_sigma_m);
+  return MatchOutcome::kAccepted;
+}
+
+bool LocalMapper::MotionSeed(const Eigen::Isometry3d& delta, double end_s,
+                             Eigen::Isometry3d& seed) const {
+  if (!have_motion_ || !(config_.motion_seed_max_age_s > 0) || !(motion_s_ > 0) ||
+      !(end_s - motion_end_s_ <= config_.motion_seed_max_age_s)) {
+    return false;
+  }
+  const double step_s = end_s - graph_.keyframe_stamp(last_keyframe_);
+  const double along_m = motion_m_ / motion_s_ * step_s;
+  const double odometry_m = delta.translation().norm();
+  // The odometry's direction (it turns with the robot); a step it saw as nothing has none,
+  // and then no seed of ours is better than its guess.
+  if (!(odometry_m > 0.1 * config_.keyframe_spacing_m) || !std::isfinite(along_m)) return false;
+  seed = delta;
+  seed.translation() = delta.translation() * (along_m / odometry_m);
+  // The same guess as the odometry's is no second attempt.
+  return (seed.translation() - delta.translation()).norm() > 0.5 * config_.max_correction_m;
 }
 
 void LocalMapper::ExtractPlanes() {

@@ -220,6 +220,7 @@ bool ParseNodeConfig(const std::string& text,
   r.Number("odometry", "rotation_sigma_per_m", 0.0, 1.0, c.mapper.odometry_rotation_sigma_per_m);
   r.Number("odometry", "rotation_sigma_min_rad", 1e-5, 1.0, c.mapper.odometry_rotation_sigma_min);
   r.Number("odometry", "slip_gate_chi2", 0.0, 1e6, c.mapper.odometry_gate_chi2);
+  r.Number("odometry", "motion_seed_max_age_s", 0.0, 60.0, c.mapper.motion_seed_max_age_s);
 
   r.Choice("replay", "pace", kPaces, c.pace);
   r.Number("replay", "speed", 0.01, 1000, c.speed);
