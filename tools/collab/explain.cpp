@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "msgraphs/core/collab/free_space_conflict.hpp"
 #include "msgraphs/core/collab/merge_rule.hpp"
 #include "msgraphs/core/collab/wall_index.hpp"
 
@@ -82,6 +83,25 @@ void Picture(const core::FreeSpaceSummary& f, const core::WallIndex& other, cons
     std::fclose(file);
   }
 }
+
+// Every stretch of conflict the true transform carries, in the world's frame (the truth's).
+class ConflictCsv final : public core::ConflictVisitor {
+ public:
+  ConflictCsv(std::FILE* file, const char* direction, const Eigen::Isometry3d& T_world_y)
+      : file_(file), direction_(direction), T_world_y_(T_world_y) {}
+  void Counted(core::ConflictKind kind, const Eigen::Vector2d& a_y, const Eigen::Vector2d& b_y, double length_m) override {
+    const Eigen::Vector3d a = T_world_y_ * Eigen::Vector3d(a_y.x(), a_y.y(), 0);
+    const Eigen::Vector3d b = T_world_y_ * Eigen::Vector3d(b_y.x(), b_y.y(), 0);
+    std::fprintf(file_, "%s,%s,%.2f,%.2f,%.2f,%.2f,%.2f\n", direction_,
+                 kind == core::ConflictKind::kWallInFree ? "wall_in_free" : "opening_on_solid", a.x(), a.y(), b.x(),
+                 b.y(), length_m);
+  }
+
+ private:
+  std::FILE* file_;
+  const char* direction_;
+  Eigen::Isometry3d T_world_y_;
+};
 
 const char* Cause(const ViewEvaluation& v, const ViewExplanation& e, const core::MergeRuleConfig& rule) {
   if (v.merged) return v.verdict == Verdict::kWrong ? "merged wrongly" : v.verdict == Verdict::kRight ? "right" : "unchecked";
@@ -175,6 +195,17 @@ std::vector<ViewExplanation> ExplainViews(const Mission& mission, const Evaluati
                 stem + ".ppm");
         Picture(sb.free_space(), own[a], sa.free_space(), e.truth.T_a_b.inverse(), config.merge.conflict.clearance_m,
                 stem + "_back.ppm");
+        if (std::FILE* file = std::fopen((stem + "_conflicts.csv").c_str(), "w")) {
+          std::fprintf(file, "# the true transform's conflict, stretch by stretch, world frame (truth)\n"
+                             "direction,kind,ax_m,ay_m,bx_m,by_m,length_m\n");
+          ConflictCsv b_in_a(file, "b_in_a", ra.own.T_truth_estimate);
+          static_cast<void>(core::ConflictOf(walls_b, sb.free_space(), e.truth.T_a_b, own[a], sa.free_space(),
+                                             config.merge.conflict, &b_in_a));
+          ConflictCsv a_in_b(file, "a_in_b", rb.own.T_truth_estimate);
+          static_cast<void>(core::ConflictOf(own[a], sa.free_space(), e.truth.T_a_b.inverse(), walls_b,
+                                             sb.free_space(), config.merge.conflict, &a_in_b));
+          std::fclose(file);
+        }
       }
     }
     e.cause = Cause(v, e, config.merge);

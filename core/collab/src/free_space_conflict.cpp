@@ -69,7 +69,8 @@ Status FreeSpaceConflictConfig::Validate() const {
 
 FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& summary_x,
                              const PlanarTransform& T_y_x, const WallIndex& walls_y,
-                             const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& c) {
+                             const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& c,
+                             ConflictVisitor* visitor) {
   FreeSpaceConflict out;
   if (summary_y.empty()) return out;
   const double step = c.sample_step_m;
@@ -86,8 +87,13 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
     // and there (an extent grown past a door, a furniture face one robot mapped as a wall).
     int run = 0;
     const auto min_run = static_cast<int>(std::ceil(c.min_stretch_m / (inner / n)));
-    auto close_run = [&]() {
-      if (run >= min_run) out.walls_in_free_m += inner * run / n;
+    auto close_run = [&](int end) {
+      if (run >= min_run) {
+        out.walls_in_free_m += inner * run / n;
+        if (visitor != nullptr)
+          visitor->Counted(ConflictKind::kWallInFree, a + (b - a) * (static_cast<double>(end - run) / n),
+                           a + (b - a) * (static_cast<double>(end) / n), inner * run / n);
+      }
       run = 0;
     };
     for (int i = 0; i < n; ++i) {
@@ -97,9 +103,9 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
       if (in_free)
         ++run;
       else
-        close_run();
+        close_run(i);
     }
-    close_run();
+    close_run(n);
   }
   for (const Opening& o : summary_x.openings()) {
     const Eigen::Vector2d a = T_y_x * o.a, b = T_y_x * o.b;
@@ -114,8 +120,10 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
       if (!NearWall(walls_y, p, c.door_wall_distance_m)) continue;
       solid += width / n;
     }
-    if (solid >= c.door_solid_share * width && !SameDoorway(summary_y, a, b, c.door_wall_distance_m, c.max_opening_m))
+    if (solid >= c.door_solid_share * width && !SameDoorway(summary_y, a, b, c.door_wall_distance_m, c.max_opening_m)) {
       out.openings_on_solid_m += solid;
+      if (visitor != nullptr) visitor->Counted(ConflictKind::kOpeningOnSolid, a, b, solid);
+    }
   }
   return out;
 }

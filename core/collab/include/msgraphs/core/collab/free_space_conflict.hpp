@@ -53,10 +53,20 @@ struct FreeSpaceConflict {
   double total_m() const { return walls_in_free_m + openings_on_solid_m; }
 };
 
+enum class ConflictKind : std::uint8_t { kWallInFree, kOpeningOnSolid };
+
+/// Told of every stretch that counted (y's frame), for audits (msgraphs_collab --explain).
+class ConflictVisitor {
+ public:
+  virtual ~ConflictVisitor() = default;
+  virtual void Counted(ConflictKind kind, const Eigen::Vector2d& a_y, const Eigen::Vector2d& b_y, double length_m) = 0;
+};
+
 /// Robot x's walls and openings (x's frame), laid into robot y's frame by T_y_x, against y's
 /// summary and walls.
 FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& summary_x,
                              const PlanarTransform& T_y_x, const WallIndex& walls_y,
-                             const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& config);
+                             const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& config,
+                             ConflictVisitor* visitor = nullptr);
 
 }  // namespace msgraphs::core
