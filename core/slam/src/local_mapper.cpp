@@ -97,7 +97,7 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   floor_members_.Init(config.max_scan_points);
   next_sequence_ = 1;
   have_keyframe_ = false;
-  have_motion_ = false;
+  motion_m_ = motion_s_ = motion_end_s_ = 0;
   T_map_odom_ = Eigen::Isometry3d::Identity();
   path_m_ = 0;
   keyframes_since_rooms_ = keyframes_since_full_ = 0;
@@ -246,7 +246,6 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
       case MatchOutcome::kOverlap: ++stats_.scan_match_rejected_overlap; break;
       case MatchOutcome::kDiverged: ++stats_.scan_match_rejected_diverged; break;
     }
-    if (!matched) T_last_new = delta;
   } else if (have_keyframe_) {
     ++stats_.scan_match_rejected_failed;
   }
@@ -336,7 +335,6 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   }
   Stage(observer, MapperStage::kRooms);
   if (matched) {
-    have_motion_ = true;
     motion_m_ = T_last_new.translation().norm();
     motion_s_ = scan.end_s - graph_.keyframe_stamp(last_keyframe_);
     motion_end_s_ = scan.end_s;
@@ -373,7 +371,7 @@ LocalMapper::MatchOutcome LocalMapper::MatchFrom(const Eigen::Isometry3d& T_last
 
 bool LocalMapper::MotionSeed(const Eigen::Isometry3d& delta, double end_s,
                              Eigen::Isometry3d& seed) const {
-  if (!have_motion_ || !(config_.motion_seed_max_age_s > 0) || !(motion_s_ > 0) ||
+  if (!(config_.motion_seed_max_age_s > 0) || !(motion_s_ > 0) ||
       !(end_s - motion_end_s_ <= config_.motion_seed_max_age_s)) {
     return false;
   }

@@ -73,9 +73,10 @@ struct LocalMapperConfig {
   /// When the odometry's step disagrees with the pace the last accepted match measured (its
   /// speed along the odometry's direction, over this step's time) by more than half
   /// max_correction_m, the scan is registered from that guess too, held to the same tests
-  /// against it, and the better fit kept; the slip gate then weakens the step's odometry. The last match's
-  /// motion stands for the robot's for this long (a walking robot keeps its pace over a stride
-  /// or two; after a few unmatched seconds it says no more than the encoders). 0: off.
+  /// against it, and the better fit kept; the slip gate then weakens the step's odometry.
+  /// The last match's motion stands for the robot's for this long (a walking robot keeps its
+  /// pace over a stride or two; after a few unmatched seconds it says no more than the
+  /// encoders). 0: off.
   double motion_seed_max_age_s = 3.0;
   /// Encoder odometry factor: sigma grows with the motion. Configuration values from the
   /// robot's odometry, not fitted: 3 % of the distance (a legged robot's encoders: 1-2 % scale
@@ -312,8 +313,8 @@ class LocalMapper {
   Eigen::Isometry3d last_odometry_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
   double path_m_ = 0;
-  // The last accepted scan match: metres it moved, over seconds, ending at motion_end_s_.
-  bool have_motion_ = false;
+  // The last accepted scan match: metres it moved, over seconds (0: none yet), ending at
+  // motion_end_s_.
   double motion_m_ = 0, motion_s_ = 0, motion_end_s_ = 0;
   std::size_t keyframes_since_rooms_ = 0, keyframes_since_full_ = 0;
   LocalMapperStats stats_;
