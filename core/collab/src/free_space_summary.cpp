@@ -153,9 +153,12 @@ void FreeSpaceSummary::FindOpenings(const FreeSpaceGrid& grid, const DistilledWa
     return grid.ToCell(p, x, y) && grid.clear_below_sensor(x, y) &&
            grid.state(x, y) != FreeSpaceGrid::Cell::kOccupied;
   };
+  // Nothing ever returned from the cell. Not the grid's state: a wall seen edge-on is crossed
+  // by many grazing rays and hit by few, so its cells read "not occupied" although solid; an
+  // opening there would contradict a peer's true wall (m010-warehouse of the benchmark).
   auto unhit_at = [&](const Eigen::Vector2d& p) {
     int x = 0, y = 0;
-    return grid.ToCell(p, x, y) && grid.state(x, y) != FreeSpaceGrid::Cell::kOccupied;
+    return grid.ToCell(p, x, y) && !grid.ever_occupied(x, y);
   };
   const auto steps = static_cast<int>(length / step);
   int run_start = -1, last_open = -2;

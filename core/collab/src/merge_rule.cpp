@@ -36,7 +36,7 @@ const char* ToString(MergeVerdict v) {
     case MergeVerdict::kContradicted:
       return "the strongest hypothesis is refuted by free space";
     case MergeVerdict::kUnconfirmed:
-      return "the leader awaits confirmation by the next decision";
+      return "the leader awaits confirmation by a decision on new evidence";
     case MergeVerdict::kMerge:
       return "merge";
   }

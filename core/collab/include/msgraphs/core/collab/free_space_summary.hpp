@@ -13,7 +13,8 @@
 //   towards the ceiling) and none is occupied;
 // - unknown otherwise.
 // And the openings: where the robot saw through one of its own walls (a door, a wide opening),
-// from the fine grid: clear on both sides of the wall's line and not occupied across its body. A peer's wall
+// from the fine grid: clear on both sides of the wall's line and no return ever across its body
+// (FreeSpaceGrid::ever_occupied: a wall seen edge-on is crossed by more rays than hit it). A peer's wall
 // across one of them is a lintel, not a conflict; a peer's opening on a wall seen solid here is.
 // After Build or Decode, every free cell carries its clearance (chamfer distance to the nearest
 // non-free cell), so that a conflict is only counted well inside what was seen (a wall one

@@ -72,7 +72,9 @@ struct MergeRuleConfig {
   /// A new merge needs the same leader to win this many decisions, no other leader winning in
   /// between (each decision is on new data: the search and the rule run when a map or a free
   /// space changed), so that what the robots see next can refute it before it is acted on: two robots that just left identical
-  /// rooms agree perfectly on the wrong copy until one of them sees past it. 1: at once.
+  /// rooms agree perfectly on the wrong copy until one of them sees past it. A decision confirms
+  /// only on a newer graph that added at least `conflict.min_stretch_m` of agreement to the
+  /// leader (collab_merge.cpp). 1: at once.
   std::uint32_t confirmations = 2;
   /// The conflict limits grow with the evidence: each is the larger of its value above and
   /// this share of the hypothesis' agreement (times 1, 2, 4 for accept, refute, undo). Maps a

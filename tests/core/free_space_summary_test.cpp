@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: MIT
+// The free-space summary's openings: where a robot saw through one of its own walls, and only
+// there.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "msgraphs/core/collab/free_space_summary.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+// A 6 m wall on y = 0 from x = 0 to 6, a 1 m door from x = 2 to 3; floor at z = 0.
+constexpr float kDoorFrom = 2.0f, kDoorTo = 3.0f, kWallTo = 6.0f;
+
+bool InDoor(float x) { return x > kDoorFrom && x < kDoorTo; }
+
+// What a sensor at (x, y_side, 0.8) sees looking at the wall across x from -1 to 7: the wall's
+// face where it stands, the floor 3 m beyond it through the door or past its ends. Every ray
+// descends, so it clears below the sensor.
+std::vector<Eigen::Vector3f> LookAtTheWall(const Eigen::Vector3f& sensor) {
+  std::vector<Eigen::Vector3f> points;
+  for (float x = -1.0f; x <= 7.0f; x += 0.02f) {
+    const bool solid = x >= 0.0f && x <= kWallTo && !InDoor(x);
+    if (solid) {
+      points.emplace_back(x, 0.0f, 0.5f);
+    } else {
+      // Beyond the wall's line, as far again as the sensor is in front of it.
+      points.emplace_back(sensor.x() + 2.0f * (x - sensor.x()), -sensor.y(), 0.3f);
+    }
+  }
+  return points;
+}
+
+FreeSpaceGrid Grid() {
+  FreeSpaceGridConfig config;
+  config.width = 200;
+  config.height = 200;
+  config.origin_m = {-10.0f, -10.0f};
+  FreeSpaceGrid grid;
+  EXPECT_TRUE(grid.Init(config).has_value());
+  return grid;
+}
+
+DistilledWall TheWall() {
+  DistilledWall wall;
+  wall.normal = Eigen::Vector3d::UnitY();
+  wall.d = 0;
+  wall.a = {0, 0};
+  wall.b = {kWallTo, 0};
+  return wall;
+}
+
+std::vector<Opening> Openings(const FreeSpaceGrid& grid) {
+  FreeSpaceSummary summary;
+  EXPECT_TRUE(summary.Init({}).has_value());
+  const DistilledWall wall = TheWall();
+  EXPECT_TRUE(summary.Build(grid, std::span<const DistilledWall>(&wall, 1)).has_value());
+  return {summary.openings().begin(), summary.openings().end()};
+}
+
+void ExpectOnlyTheDoor(const std::vector<Opening>& openings) {
+  ASSERT_EQ(openings.size(), 1u);
+  const double from = std::min(openings[0].a.x(), openings[0].b.x());
+  const double to = std::max(openings[0].a.x(), openings[0].b.x());
+  EXPECT_NEAR(from, kDoorFrom, 0.2);
+  EXPECT_NEAR(to, kDoorTo, 0.2);
+}
+
+TEST(FreeSpaceSummary, ADoorSeenFromBothSidesIsAnOpening) {
+  FreeSpaceGrid grid = Grid();
+  for (const Eigen::Vector3f& sensor : {Eigen::Vector3f(3, 2.8f, 0.8f), Eigen::Vector3f(3, -2.8f, 0.8f)}) {
+    const auto points = LookAtTheWall(sensor);
+    grid.Integrate(sensor, points, 0.0f);
+  }
+  ExpectOnlyTheDoor(Openings(grid));
+}
+
+// A robot walking along the wall's line sees the wall edge-on: its rays graze along the wall's
+// cells many times while the face is hit a few times from either side. The wall is still solid
+// there, and a peer's true wall must not be contradicted by a false opening.
+TEST(FreeSpaceSummary, AWallSeenEdgeOnIsNoOpening) {
+  FreeSpaceGrid grid = Grid();
+  for (const Eigen::Vector3f& sensor : {Eigen::Vector3f(3, 2.8f, 0.8f), Eigen::Vector3f(3, -2.8f, 0.8f)}) {
+    const auto points = LookAtTheWall(sensor);
+    grid.Integrate(sensor, points, 0.0f);
+  }
+  const Eigen::Vector3f in_line(-3, 0, 0.8f);
+  const std::vector<Eigen::Vector3f> grazing(100, Eigen::Vector3f(9.5f, 0, 0.5f));
+  grid.Integrate(in_line, grazing, 0.0f);
+  ExpectOnlyTheDoor(Openings(grid));
+}
+
+}  // namespace
+}  // namespace msgraphs::core
