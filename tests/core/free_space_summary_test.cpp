@@ -16,8 +16,8 @@ constexpr float kDoorFrom = 2.0f, kDoorTo = 3.0f, kWallTo = 6.0f;
 bool InDoor(float x) { return x > kDoorFrom && x < kDoorTo; }
 
 // What a sensor at (x, y_side, 0.8) sees looking at the wall across x from -1 to 7: the wall's
-// face where it stands, the floor 3 m beyond it through the door or past its ends. Every ray
-// descends, so it clears below the sensor.
+// face where it stands, the floor beyond it (as far behind the wall's line as the sensor is in
+// front) through the door or past its ends. Every ray descends, so it clears below the sensor.
 std::vector<Eigen::Vector3f> LookAtTheWall(const Eigen::Vector3f& sensor) {
   std::vector<Eigen::Vector3f> points;
   for (float x = -1.0f; x <= 7.0f; x += 0.02f) {
@@ -40,6 +40,14 @@ FreeSpaceGrid Grid() {
   FreeSpaceGrid grid;
   EXPECT_TRUE(grid.Init(config).has_value());
   return grid;
+}
+
+// The wall looked at from 2.8 m in front of its door and from 2.8 m behind it.
+void LookFromBothSides(FreeSpaceGrid& grid) {
+  for (const Eigen::Vector3f& sensor : {Eigen::Vector3f(3, 2.8f, 0.8f), Eigen::Vector3f(3, -2.8f, 0.8f)}) {
+    const auto points = LookAtTheWall(sensor);
+    grid.Integrate(sensor, points, 0.0f);
+  }
 }
 
 DistilledWall TheWall() {
@@ -69,10 +77,7 @@ void ExpectOnlyTheDoor(const std::vector<Opening>& openings) {
 
 TEST(FreeSpaceSummary, ADoorSeenFromBothSidesIsAnOpening) {
   FreeSpaceGrid grid = Grid();
-  for (const Eigen::Vector3f& sensor : {Eigen::Vector3f(3, 2.8f, 0.8f), Eigen::Vector3f(3, -2.8f, 0.8f)}) {
-    const auto points = LookAtTheWall(sensor);
-    grid.Integrate(sensor, points, 0.0f);
-  }
+  LookFromBothSides(grid);
   ExpectOnlyTheDoor(Openings(grid));
 }
 
@@ -81,10 +86,7 @@ TEST(FreeSpaceSummary, ADoorSeenFromBothSidesIsAnOpening) {
 // there, and a peer's true wall must not be contradicted by a false opening.
 TEST(FreeSpaceSummary, AWallSeenEdgeOnIsNoOpening) {
   FreeSpaceGrid grid = Grid();
-  for (const Eigen::Vector3f& sensor : {Eigen::Vector3f(3, 2.8f, 0.8f), Eigen::Vector3f(3, -2.8f, 0.8f)}) {
-    const auto points = LookAtTheWall(sensor);
-    grid.Integrate(sensor, points, 0.0f);
-  }
+  LookFromBothSides(grid);
   const Eigen::Vector3f in_line(-3, 0, 0.8f);
   const std::vector<Eigen::Vector3f> grazing(100, Eigen::Vector3f(9.5f, 0, 0.5f));
   grid.Integrate(in_line, grazing, 0.0f);
