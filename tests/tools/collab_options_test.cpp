@@ -28,7 +28,8 @@ TEST(CollabOptions, ThresholdsDelaysAndSummaryAreOptions) {
   Options o;
   std::string error;
   ASSERT_TRUE(Parse({"--run", "/r", "--wrong-origin-m", "0.25", "--wrong-origin-deg", "1.5",
-                     "--delay-s", "2=90", "--summary", "/s.json", "--mode", "keyframes"},
+                     "--delay-s", "2=90", "--summary", "/s.json", "--mode", "keyframes",
+                     "--until-s", "20.05"},
                     o, error))
       << error;
   EXPECT_EQ(o.evaluation.wrong_origin_m, 0.25);
@@ -36,11 +37,13 @@ TEST(CollabOptions, ThresholdsDelaysAndSummaryAreOptions) {
   EXPECT_EQ(o.delays_s.at(2), 90.0);
   EXPECT_EQ(o.summary_path, "/s.json");
   EXPECT_TRUE(o.keyframes);
-  // The defaults: 0.5 m and 2 deg.
+  EXPECT_EQ(o.until_s, 20.05);
+  // The defaults: 0.5 m and 2 deg, and the whole mission.
   Options d;
   ASSERT_TRUE(Parse({"--run", "/r"}, d, error));
   EXPECT_EQ(d.evaluation.wrong_origin_m, 0.5);
   EXPECT_EQ(d.evaluation.wrong_origin_deg, 2.0);
+  EXPECT_EQ(d.until_s, 0.0);
 }
 
 TEST(CollabOptions, BadValuesAreRefusedWithAReason) {
@@ -49,6 +52,8 @@ TEST(CollabOptions, BadValuesAreRefusedWithAReason) {
         {"--run", "/r", "--wrong-origin-deg", "x"},
         {"--run", "/r", "--delay-s", "2"},
         {"--run", "/r", "--exchange-every-s", "0"},
+        {"--run", "/r", "--until-s", "0"},
+        {"--run", "/r", "--until-s", "nan"},
         {"--run", "/r", "--mode", "magic"},
         {"--run", "/r", "--summary"},
         {"--wrong-origin-m", "0.5"}}) {

@@ -19,6 +19,7 @@ ExchangeRecord Record(const Mission& mission, double t) {
 
 MissionRun RunLockStep(Mission& mission,
                        double every_s,
+                       double until_s,
                        const std::function<void(double)>& after_exchange) {
   const auto t0 = std::chrono::steady_clock::now();
   MissionRun run;
@@ -31,6 +32,7 @@ MissionRun RunLockStep(Mission& mission,
     }
     if (next == nullptr) break;
     const double t = NextScanTime_s(*next);
+    if (until_s > 0 && t >= until_s) break;
     if (t >= next_exchange) {
       mission.Exchange(t);
       run.exchanges.push_back(Record(mission, t));

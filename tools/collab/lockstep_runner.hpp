@@ -27,8 +27,10 @@ struct MissionRun {
 };
 
 /// Runs the mission; `after_exchange(mission_time_s)` is called after every exchange.
+/// `until_s` > 0 ends it at the first scan at or after that mission time.
 MissionRun RunLockStep(Mission& mission,
                        double every_s,
+                       double until_s,
                        const std::function<void(double)>& after_exchange);
 
 }  // namespace msgraphs::tools::collab

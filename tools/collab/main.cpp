@@ -21,14 +21,15 @@
 //                   [--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off]
 //                   [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]...
 //                   [--wrong-origin-m 0.5] [--wrong-origin-deg 2] [--out DIR] [--summary FILE]
-//                   [--markdown]
+//                   [--until-s S] [--markdown]
 //
 // --feedback on (the default) gives each robot's local S-Graph the other robots' measurements of
 // its matched walls, through the merged origins (CollabSession::PlanePriors).
 // Start delays come from DIR/mission.txt (`robot N ... start_delay_s S`) when it has them;
 // --delay-s N=S overrides robot N's.
 // --out DIR writes robotB_in_robotA.tum for every view and bytes.csv (outputs.hpp); --summary
-// FILE the machine-readable summary (JSON, docs/collab-summary.md).
+// FILE the machine-readable summary (JSON, docs/collab-summary.md). --until-s S ends the mission
+// at mission time S: everything is reported as it stood then.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -86,7 +87,7 @@ int main(int argc, char** argv) {
   }
 
   MergeTracker tracker(mission.robots.size());
-  const MissionRun run = RunLockStep(mission, o.every_s, [&](double mission_time_s) {
+  const MissionRun run = RunLockStep(mission, o.every_s, o.until_s, [&](double mission_time_s) {
     tracker.AfterExchange(mission, mission_time_s);
   });
   const Evaluation evaluation = Evaluate(mission, tracker, o.evaluation);

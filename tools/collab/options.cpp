@@ -45,6 +45,10 @@ bool ParseOptions(int argc, char** argv, Options& o, std::string& error) {
       o.explain_dir = v;
     } else if (a == "--exchange-every-s") {
       if (!Number(v, o.every_s) || !(o.every_s > 0)) return fail(a + " takes seconds > 0");
+    } else if (a == "--until-s") {
+      // The mission as it stood at S: the report and --explain judge the maps and decisions of
+      // that moment (a merge at 20 s undone at 30 s is seen as it was decided).
+      if (!Number(v, o.until_s) || !(o.until_s > 0)) return fail(a + " takes seconds > 0");
     } else if (a == "--delay-s") {
       // ROBOT=SECONDS: that robot starts later in mission time (a late joiner when longer than
       // the others' missions: it arrives with its whole map).

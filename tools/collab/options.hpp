@@ -21,6 +21,7 @@ struct Options {
   bool feedback = true;
   bool markdown = false;
   double every_s = 10.0;
+  double until_s = 0;  ///< --until-s: the mission ends at this mission time (0: at its end)
   std::map<int, double> delays_s;  ///< --delay-s: robot id -> start delay
   core::CollabSessionConfig session;
   EvaluationConfig evaluation;
@@ -33,7 +34,7 @@ inline constexpr const char* kUsage =
     "                       [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]...\n"
     "                       [--wrong-origin-m 0.5]\n"
     "                       [--wrong-origin-deg 2] [--out DIR] [--summary FILE] [--explain DIR]\n"
-    "                       [--markdown]\n";
+    "                       [--until-s S] [--markdown]\n";
 
 /// False with `error` on a bad command line (the caller prints it and the usage, exit 2).
 bool ParseOptions(int argc, char** argv, Options& o, std::string& error);

@@ -120,23 +120,29 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
   // (ours or the peer's): one exchange brings the peer's graph, its free space and its room
   // matches as separate messages, each a decision, and three wrong merges of the benchmark were
   // "confirmed" by the second decision of the exchange that proposed them. And the newer
-  // graphs must have added evidence for it: at least one conflict stretch (min_stretch_m, the
-  // least that counts against a transform) more of wall laid on wall. A newer graph whose new
-  // walls all fall where the other robot has not looked, or only on its free space's edges,
-  // tests nothing: in m014-multi-wing of the benchmark, two robots each in its own copy of a
-  // wing agreed on the same 17.8 m of wall at 10 and 20 s, and the second decision "confirmed"
-  // a transform 14 m off.
+  // graphs must have added evidence for it in its weakest direction: at least one conflict
+  // stretch (min_stretch_m, the least that counts against a transform) more of wall laid on
+  // wall across that direction (the constraint, WallAgreement::constraint_m). A newer graph
+  // whose new walls all fall where the other robot has not looked, or only on its free
+  // space's edges, tests nothing: in m014-multi-wing of the benchmark, two robots each in its
+  // own copy of a wing agreed on the same 17.8 m of wall at 10 and 20 s, and the second
+  // decision "confirmed" a transform 14 m off. Nor do new walls along the weakest direction: a
+  // slide along it keeps them on wall. In the office demo, robot 3 took robot 1 six metres down
+  // a corridor: its agreement grew from 29.5 to 114 m between 10 and 20 s, all of it corridor
+  // wall, while the 11.6 m of cross wall that fixed the slide (two rooms' walls coinciding by
+  // chance) stayed the same, and the true transform, the same corridor with nothing across,
+  // stood beside it unrefuted.
   if (d.verdict == MergeVerdict::kMerge && !d.keeping) {
     const bool newer = own_version != p.pending_own || p.graph.version != p.pending_peer;
-    const double agreement_m = d.leader.agreement.agreement_m;
+    const double constraint_m = d.leader.agreement.constraint_m;
     if (p.pending_count > 0 && SameTransform(d.leader.T_a_b, p.pending_T, 2 * same_m, 2 * same_rad)) {
-      if (newer && agreement_m >= p.pending_agreement_m + config.merge.conflict.min_stretch_m) {
+      if (newer && constraint_m >= p.pending_constraint_m + config.merge.conflict.min_stretch_m) {
         ++p.pending_count;
-        p.pending_agreement_m = agreement_m;
+        p.pending_constraint_m = constraint_m;
       }
     } else {
       p.pending_count = 1;
-      p.pending_agreement_m = agreement_m;
+      p.pending_constraint_m = constraint_m;
     }
     p.pending_own = own_version;
     p.pending_peer = p.graph.version;

@@ -101,8 +101,9 @@ struct CollabSession::Impl {
     std::uint32_t pending_count = 0;
     // The graphs (own, the peer's) it last led on: only a decision on a newer graph confirms.
     std::uint32_t pending_own = 0, pending_peer = 0;
-    // Its agreement (metres of wall on wall) when it last counted: a confirmation needs more.
-    double pending_agreement_m = 0;
+    // Its constraint (metres of wall on wall in its weakest direction) when it last counted: a
+    // confirmation needs more.
+    double pending_constraint_m = 0;
     std::uint32_t solved_version = 0;  // its graph's version at the last solve
     Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();
     CollabPeerStats stats;

@@ -26,10 +26,11 @@
 //    contradicted, the likeliest explanation is an error in the free space or the maps (the
 //    true transform refuted by an artefact), not that a much weaker alternative is true; and a
 //    weaker alternative is what a repeated structure (a mirrored wing) offers.
-// Then: merge with the leader, once it has led `confirmations` consecutive decisions. A merged pair is kept while its hypothesis has at most
-// `undo_conflict_m` of conflict and no rival beats it by the margin (hysteresis: accept at
-// accept_conflict_m, refute others beyond refute_conflict_m, undo a merge beyond
-// undo_conflict_m).
+// 6. Then: merge with the leader, once it has led `confirmations` consecutive decisions, each
+//    confirming one on a newer graph with more wall on wall in its weakest direction.
+// A merged pair is kept while its hypothesis has at most `undo_conflict_m` of conflict and no
+// rival beats it by the margin (hysteresis: accept at accept_conflict_m, refute others beyond
+// refute_conflict_m, undo a merge beyond undo_conflict_m).
 //
 // Why this does not merge wrongly (docs/multi-robot.md, "The merge rule"): a wrong transform
 // that wins must (a) contradict nothing either robot saw, (b) lay walls on walls in two
@@ -71,10 +72,12 @@ struct MergeRuleConfig {
   std::size_t max_slide_probes = 128;
   /// A new merge needs the same leader to win this many decisions, no other leader winning in
   /// between (each decision is on new data: the search and the rule run when a map or a free
-  /// space changed), so that what the robots see next can refute it before it is acted on: two robots that just left identical
-  /// rooms agree perfectly on the wrong copy until one of them sees past it. A decision confirms
-  /// only on a newer graph that added at least `conflict.min_stretch_m` of agreement to the
-  /// leader (collab_merge.cpp). 1: at once.
+  /// space changed), so that what the robots see next can refute it before it is acted on: two
+  /// robots that just left identical rooms agree perfectly on the wrong copy until one of them
+  /// sees past it. A decision confirms only on a newer graph that added at least
+  /// `conflict.min_stretch_m` of wall on wall to the leader in its weakest direction (its
+  /// constraint; wall along that direction cannot tell a slide along it: collab_merge.cpp).
+  /// 1: at once.
   std::uint32_t confirmations = 2;
   /// The conflict limits grow with the evidence: each is the larger of its value above and
   /// this share of the hypothesis' agreement (times 1, 2, 4 for accept, refute, undo). Maps a
