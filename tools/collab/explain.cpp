@@ -195,6 +195,13 @@ std::vector<ViewExplanation> ExplainViews(const Mission& mission, const Evaluati
                 stem + ".ppm");
         Picture(sb.free_space(), own[a], sa.free_space(), e.truth.T_a_b.inverse(), config.merge.conflict.clearance_m,
                 stem + "_back.ppm");
+        // The rule's leader when it is not the truth: what the evidence looked like under it.
+        if (e.decision.has_leader && e.leader_truth_distance_m > 0.5) {
+          Picture(sa.free_space(), walls_b, sb.free_space(), e.decision.leader.T_a_b,
+                  config.merge.conflict.clearance_m, stem + "_leader.ppm");
+          Picture(sb.free_space(), own[a], sa.free_space(), e.decision.leader.T_a_b.inverse(),
+                  config.merge.conflict.clearance_m, stem + "_leader_back.ppm");
+        }
         if (std::FILE* file = std::fopen((stem + "_conflicts.csv").c_str(), "w")) {
           std::fprintf(file, "# the true transform's conflict, stretch by stretch, world frame (truth)\n"
                              "direction,kind,ax_m,ay_m,bx_m,by_m,length_m\n");

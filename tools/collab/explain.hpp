@@ -13,7 +13,8 @@
 // - "merged wrongly" / "merged, then undone" and so on from the final decision.
 // --explain DIR also draws each summary with the other robot's walls laid in by the truth (PPM:
 // unknown grey, free white, occupied black, the other's walls orange, red where they conflict,
-// openings blue).
+// openings blue; the other's openings magenta), and again under the rule's leader where that is
+// not the truth (`_leader.ppm`).
 #pragma once
 
 #include <string>
