@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "evaluation_config.hpp"
 #include "msgraphs/core/collab/free_space_conflict.hpp"
 #include "msgraphs/core/collab/merge_rule.hpp"
 #include "msgraphs/core/collab/wall_index.hpp"
@@ -191,17 +192,16 @@ std::vector<ViewExplanation> ExplainViews(const Mission& mission, const Evaluati
       }
       if (!pictures_dir.empty()) {
         const std::string stem = pictures_dir + "/robot" + std::to_string(v.robot) + "_in_robot" + std::to_string(v.viewer);
-        Picture(sa.free_space(), walls_b, sb.free_space(), e.truth.T_a_b, config.merge.conflict.clearance_m,
-                stem + ".ppm");
-        Picture(sb.free_space(), own[a], sa.free_space(), e.truth.T_a_b.inverse(), config.merge.conflict.clearance_m,
-                stem + "_back.ppm");
+        // Each summary with the other robot's walls laid in by `T_a_b`, both ways.
+        const auto draw = [&](const core::PlanarTransform& T_a_b, const std::string& name) {
+          Picture(sa.free_space(), walls_b, sb.free_space(), T_a_b, config.merge.conflict.clearance_m, name + ".ppm");
+          Picture(sb.free_space(), own[a], sa.free_space(), T_a_b.inverse(), config.merge.conflict.clearance_m,
+                  name + "_back.ppm");
+        };
+        draw(e.truth.T_a_b, stem);
         // The rule's leader when it is not the truth: what the evidence looked like under it.
-        if (e.decision.has_leader && e.leader_truth_distance_m > 0.5) {
-          Picture(sa.free_space(), walls_b, sb.free_space(), e.decision.leader.T_a_b,
-                  config.merge.conflict.clearance_m, stem + "_leader.ppm");
-          Picture(sb.free_space(), own[a], sa.free_space(), e.decision.leader.T_a_b.inverse(),
-                  config.merge.conflict.clearance_m, stem + "_leader_back.ppm");
-        }
+        if (e.decision.has_leader && e.leader_truth_distance_m > kWrongMatch_m)
+          draw(e.decision.leader.T_a_b, stem + "_leader");
         if (std::FILE* file = std::fopen((stem + "_conflicts.csv").c_str(), "w")) {
           std::fprintf(file, "# the true transform's conflict, stretch by stretch, world frame (truth)\n"
                              "direction,kind,ax_m,ay_m,bx_m,by_m,length_m\n");
