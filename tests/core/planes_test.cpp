@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "alloc_counter.hpp"
@@ -86,6 +87,41 @@ TEST_P(RoomPlanes, EveryFaceIsFoundInHesseFormFacingTheSensor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Yaws, RoomPlanes, ::testing::Values(0.0, 30.0, 45.0, -71.0));
+
+// A walking robot pitches and rolls by a few degrees: heights measured along the frame's z
+// would stretch an 8 m wall's 3 m by 8 sin(4 deg) = 0.56 m (and a 3 m desk face from 0.75 m
+// to a "wall" 0.96 m tall). Along the given up, the wall is as tall as the room.
+TEST(Planes, HeightsAreMeasuredAlongTheGivenUp) {
+  const Eigen::Matrix3d R_room_sensor = (Eigen::AngleAxisd(4.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitY()) *
+                                         Eigen::AngleAxisd(-3.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX()))
+                                            .toRotationMatrix();
+  const Eigen::Isometry3d T_sensor_room =
+      Eigen::Isometry3d(Eigen::Matrix3d(R_room_sensor.transpose())) * Eigen::Translation3d(-2, -3, -0.8);
+  Keyframe kf;
+  kf.From(test::BoxRoom(8, 6, 3, 60000, 0.03, 5, T_sensor_room));
+  PlaneExtractor extractor;
+  extractor.Init(200000);
+  BoundedVector<ExtractedPlane> planes(64);
+  const Eigen::Vector3d up_sensor = R_room_sensor.transpose() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d n_far_wall = R_room_sensor.transpose() * Eigen::Vector3d(0, -1, 0);  // the wall y = 6
+  ASSERT_TRUE(extractor.Extract(kf.points.span(), kf.normals.span(), {}, planes, up_sensor));
+  const ExtractedPlane* along_up = Find(planes, n_far_wall, 3.0);
+  ASSERT_NE(along_up, nullptr);
+  EXPECT_NEAR(along_up->z_max - along_up->z_min, 3.0, 0.1);
+  EXPECT_NEAR(along_up->z_max, 2.2, 0.1);  // the ceiling, 2.2 m above the sensor
+  ASSERT_TRUE(extractor.Extract(kf.points.span(), kf.normals.span(), {}, planes));
+  const ExtractedPlane* along_z = Find(planes, n_far_wall, 3.0);
+  ASSERT_NE(along_z, nullptr);
+  EXPECT_GT(along_z->z_max - along_z->z_min, 3.3);
+  // An up that is no up is refused, not used.
+  EXPECT_EQ(extractor.Extract(kf.points.span(), kf.normals.span(), {}, planes, Eigen::Vector3d::UnitX()).error().code,
+            Errc::kInvalidArgument);
+  EXPECT_EQ(extractor.Extract(kf.points.span(), kf.normals.span(), {}, planes,
+                              Eigen::Vector3d(0, 0, std::numeric_limits<double>::quiet_NaN()))
+                .error()
+                .code,
+            Errc::kInvalidArgument);
+}
 
 TEST(Planes, CollinearWallsWithAGapAreSeparateSegments) {
   // Two 3 m pieces of the wall y = 4 with a 2 m doorway-sized gap between x = 3 and x = 5.

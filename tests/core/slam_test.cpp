@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 
 #include "alloc_counter.hpp"
@@ -88,6 +89,31 @@ ExtractedPlane Wall(const Eigen::Vector3d& n, double d, double u_min, double u_m
   p.z_max = 2.0;
   p.inliers = 500;
   return p;
+}
+
+// A desk's or sofa's face can be long and, seen tilted, tall; it never rises above the sensor,
+// a wall in range always does (the VLP-16's upward beams hit it there).
+TEST(PlaneMapper, AVerticalPlaneThatStaysBelowTheSensorIsFurniture) {
+  SGraph g;
+  ASSERT_TRUE(g.Init({}));
+  PlaneMapper m;
+  PlaneAssociationConfig config;
+  config.sensor_height_m = 0.3;  // Spot: the VLP-16 0.3 m above the base
+  ASSERT_TRUE(m.Init(64, config));
+  const std::uint32_t k0 = *g.AddKeyframe(0, Pose(0, 0, 0));
+  ExtractedPlane desk = Wall(Eigen::Vector3d(-1, 0, 0), 1.5, -1.5, 1.5);  // 3 m long
+  desk.z_min = -0.5;
+  desk.z_max = 0.35;  // 0.85 m tall (above min_wall_height_m), top 5 cm above the sensor
+  ExtractedPlane wall = Wall(Eigen::Vector3d(-1, 0, 0), 4.0, -2.0, 2.0);
+  wall.z_min = -0.5;
+  wall.z_max = 0.45;  // what the +1 to +3 degree beams see of a wall 4 m away over clutter
+  std::vector<ExtractedPlane> planes{desk, wall};
+  ASSERT_TRUE(m.Associate(g, k0, planes));
+  EXPECT_EQ(m.stats().furniture, 1u);
+  EXPECT_EQ(m.stats().created, 1u);
+  EXPECT_NEAR(std::fabs(g.plane(0).d), 4.0, 1e-6);
+  config.min_rise_above_sensor_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(m.Init(64, config));
 }
 
 TEST(PlaneMapper, AssociatesBySideAndExtentNotJustByLine) {

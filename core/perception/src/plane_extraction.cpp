@@ -52,7 +52,8 @@ void PlaneExtractor::Init(std::size_t max_points) {
 }
 
 bool PlaneExtractor::FitAndDescribe(std::span<const Eigen::Vector3f> points, std::span<const std::uint32_t> members,
-                                    const PlaneExtractionConfig& config, ExtractedPlane& plane) const {
+                                    const PlaneExtractionConfig& config, const Eigen::Vector3d& up,
+                                    ExtractedPlane& plane) const {
   if (members.size() < 3) return false;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::uint32_t i : members) mean += points[i].cast<double>();
@@ -85,8 +86,9 @@ bool PlaneExtractor::FitAndDescribe(std::span<const Eigen::Vector3f> points, std
     const double a = u.dot(p);
     u_min = std::min(u_min, a);
     u_max = std::max(u_max, a);
-    z_min = std::min(z_min, p.z());
-    z_max = std::max(z_max, p.z());
+    const double h = up.dot(p);
+    z_min = std::min(z_min, h);
+    z_max = std::max(z_max, h);
   }
   const double rms = std::sqrt(sum_r2 / static_cast<double>(members.size()));
   const double sigma = std::max(rms, static_cast<double>(config.min_sigma_m));
@@ -110,9 +112,15 @@ bool PlaneExtractor::FitAndDescribe(std::span<const Eigen::Vector3f> points, std
 }
 
 Status PlaneExtractor::Extract(std::span<const Eigen::Vector3f> points, std::span<const Eigen::Vector3f> normals,
-                               const PlaneExtractionConfig& config, BoundedVector<ExtractedPlane>& planes) {
+                               const PlaneExtractionConfig& config, BoundedVector<ExtractedPlane>& planes,
+                               const Eigen::Vector3d& up_given) {
   planes.clear();
   if (Status s = config.Validate(); !s) return s;
+  // Gravity's up is within a few degrees of the frame's z on a walking robot; anything else
+  // is a broken estimate, and heights along it would mislabel every wall.
+  if (!up_given.allFinite() || !(up_given.norm() > 0.5) || !(up_given.normalized().z() > 0.5))
+    return Error{Errc::kInvalidArgument, "planes: up must be finite and within 60 degrees of the frame's z"};
+  const Eigen::Vector3d up = up_given.normalized();
   if (round_ > 0xFFFF0000u) {  // marks would wrap: forget them explicitly
     std::fill(used_.begin(), used_.end(), 0);
     round_ = 0;
@@ -166,7 +174,7 @@ Status PlaneExtractor::Extract(std::span<const Eigen::Vector3f> points, std::spa
     std::size_t count = collect(best_n, best_d);
     if (count < min_inliers) break;
     ExtractedPlane fit;
-    if (!FitAndDescribe(points, {inliers_.data(), count}, config, fit)) break;
+    if (!FitAndDescribe(points, {inliers_.data(), count}, config, up, fit)) break;
     count = collect(fit.normal.cast<float>(), static_cast<float>(fit.d));
     if (count < min_inliers) break;
 
@@ -200,7 +208,7 @@ Status PlaneExtractor::Extract(std::span<const Eigen::Vector3f> points, std::spa
     if (horizontal) {
       if (count < config.min_horizontal_inliers) continue;
       ExtractedPlane plane;
-      if (!FitAndDescribe(points, {inliers_.data(), count}, config, plane)) continue;
+      if (!FitAndDescribe(points, {inliers_.data(), count}, config, up, plane)) continue;
       plane.kind = PlaneKind::kHorizontal;
       if (!planes.try_push_back(plane)) return Error{Errc::kCapacityExceeded, "planes: output full"};
       continue;
@@ -219,7 +227,7 @@ Status PlaneExtractor::Extract(std::span<const Eigen::Vector3f> points, std::spa
       if (n >= config.min_vertical_inliers) {
         for (std::size_t j = 0; j < n; ++j) segment_[j] = along_[start + j].second;
         ExtractedPlane plane;
-        if (FitAndDescribe(points, {segment_.data(), n}, config, plane)) {
+        if (FitAndDescribe(points, {segment_.data(), n}, config, up, plane)) {
           plane.kind = PlaneKind::kVertical;
           if (!planes.try_push_back(plane)) return Error{Errc::kCapacityExceeded, "planes: output full"};
         }

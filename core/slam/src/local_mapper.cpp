@@ -68,7 +68,9 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   odometry_.Init(config.odometry_capacity, config.odometry_max_gap_s);
   const std::size_t slots = config.graph.max_keyframes + 1;
   clouds_.Init(slots, config.cloud_store_points);
-  if (auto s = planes_mapper_.Init(config.graph.max_planes, config.association); !s) return s;
+  PlaneAssociationConfig association = config.association;
+  association.sensor_height_m = config.T_base_lidar.translation().z();  // keyframes are base frames
+  if (auto s = planes_mapper_.Init(config.graph.max_planes, association); !s) return s;
   if (auto s = rooms_.Init(config.grid, 1024, config.graph.max_rooms, config.rooms); !s) return s;
   if (auto s = loops_.Init(slots, config.max_scan_points, config.loops); !s) return s;
   if (auto s = grid_.Init(config.grid); !s) return s;
@@ -289,7 +291,7 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     path_m_ += delta.translation().norm();
   }
   // Planes.
-  ExtractPlanes();
+  ExtractPlanes(id);
   static_cast<void>(planes_mapper_.Associate(graph_, id, planes_.span()));
   Stage(observer, MapperStage::kPlanes);
   // Stored cloud and descriptor.
@@ -387,8 +389,10 @@ bool LocalMapper::MotionSeed(const Eigen::Isometry3d& delta, double end_s,
   return (seed.translation() - delta.translation()).norm() > 0.5 * config_.max_correction_m;
 }
 
-void LocalMapper::ExtractPlanes() {
-  static_cast<void>(extractor_.Extract(down_.span(), normals_.span(), config_.planes, planes_));
+void LocalMapper::ExtractPlanes(std::uint32_t keyframe) {
+  // Heights along gravity as the estimate has it (the map's z in the keyframe frame).
+  const Eigen::Vector3d up_kf = graph_.keyframe_pose(keyframe).linear().row(2).transpose();
+  static_cast<void>(extractor_.Extract(down_.span(), normals_.span(), config_.planes, planes_, up_kf));
   // Did the general search find the floor under the robot (base frame: z = -base_height_m)?
   for (const ExtractedPlane& p : planes_) {
     if (p.kind == PlaneKind::kHorizontal && p.normal.z() > 0 &&

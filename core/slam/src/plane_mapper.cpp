@@ -42,7 +42,8 @@ void Along(const WallExtent& e, const Eigen::Vector2d& dir, double& lo, double& 
 
 Status PlaneAssociationConfig::Validate() const {
   if (!(gate_chi2 > 0) || !(pose_sigma_rad > 0) || !(pose_sigma_m > 0) || !(extent_gap_m >= 0) ||
-      !(max_normal_angle_deg > 0 && max_normal_angle_deg < 90) || !(covariance_floor_m > 0)) {
+      !(max_normal_angle_deg > 0 && max_normal_angle_deg < 90) || !(covariance_floor_m > 0) ||
+      !std::isfinite(min_rise_above_sensor_m) || !std::isfinite(sensor_height_m)) {
     return Error{Errc::kInvalidConfig,
                  "plane association: gate, sigmas and angles must be positive"};
   }
@@ -71,7 +72,8 @@ Status PlaneMapper::Associate(SGraph& graph,
   for (const ExtractedPlane& p : planes) {
     const PlaneClass cls = ClassOf(p);
     if (cls == PlaneClass::kWall && (p.u_max - p.u_min < config_.min_wall_length_m ||
-                                     p.z_max - p.z_min < config_.min_wall_height_m)) {
+                                     p.z_max - p.z_min < config_.min_wall_height_m ||
+                                     p.z_max < config_.sensor_height_m + config_.min_rise_above_sensor_m)) {
       ++stats_.furniture;
       continue;
     }

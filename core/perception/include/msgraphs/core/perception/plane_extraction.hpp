@@ -41,7 +41,8 @@ struct ExtractedPlane {
   std::size_t inliers = 0;
   double rms_m = 0.0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  /// Extent of the supporting points along basis_u (walls: along the wall) and in z.
+  /// Extent of the supporting points along basis_u (walls: along the wall) and in height: along
+  /// the `up` the extraction was given (gravity in the keyframe frame; the frame's z if none).
   double u_min = 0, u_max = 0, z_min = 0, z_max = 0;
 };
 
@@ -67,24 +68,29 @@ class PlaneExtractor {
 
   /// Points in the sensor (keyframe) frame and their normals (zero normals are skipped).
   /// Appends to `planes` (cleared first); kCapacityExceeded when it fills up (the planes found
-  /// so far are kept).
+  /// so far are kept). `up` (unit, keyframe frame) is gravity's up as the pose estimate has it:
+  /// heights are measured along it, so a walking robot's roll and pitch (a few degrees) do not
+  /// stretch a 3 m desk face into a 0.9 m "wall".
   Status Extract(std::span<const Eigen::Vector3f> points,
                  std::span<const Eigen::Vector3f> normals,
                  const PlaneExtractionConfig& config,
-                 BoundedVector<ExtractedPlane>& planes);
+                 BoundedVector<ExtractedPlane>& planes,
+                 const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
 
   /// The plane of points[members] (PCA), with its covariance, normal towards the frame origin.
   bool Fit(std::span<const Eigen::Vector3f> points,
            std::span<const std::uint32_t> members,
            const PlaneExtractionConfig& config,
-           ExtractedPlane& plane) const {
-    return FitAndDescribe(points, members, config, plane);
+           ExtractedPlane& plane,
+           const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ()) const {
+    return FitAndDescribe(points, members, config, up, plane);
   }
 
  private:
   bool FitAndDescribe(std::span<const Eigen::Vector3f> points,
                       std::span<const std::uint32_t> members,
                       const PlaneExtractionConfig& config,
+                      const Eigen::Vector3d& up,
                       ExtractedPlane& plane) const;
 
   std::vector<std::uint32_t> remaining_;

@@ -280,7 +280,7 @@ class LocalMapper {
   /// The step the last accepted match's motion predicts for a scan ending at end_s, with the
   /// odometry's step `delta` giving direction and rotation; false when there is none.
   bool MotionSeed(const Eigen::Isometry3d& delta, double end_s, Eigen::Isometry3d& seed) const;
-  void ExtractPlanes();
+  void ExtractPlanes(std::uint32_t keyframe);
 
   LocalMapperConfig config_;
   SGraph graph_;

@@ -34,6 +34,17 @@ struct PlaneAssociationConfig {
   double extent_gap_m = 1.0;           ///< a wall's new piece must be this close to its extent
   double min_wall_length_m = 0.5;      ///< shorter or lower vertical planes are furniture faces
   double min_wall_height_m = 0.8;
+  /// A wall rises above the sensor: every upward beam of the VLP-16 (+1 to +15 degrees) hits a
+  /// wall in range above the sensor's height, a desk, a sofa or a low cabinet only below it. A
+  /// vertical plane whose highest return (along gravity, keyframe frame) is not this much above
+  /// the sensor is a furniture face, whatever its size. The margin covers Spot's body bob (a
+  /// few cm) and a degree of tilt error over a few metres. This is also what keeps the maps'
+  /// walls consistent with their free space: a descending ray that passed over a 0.75 m desk
+  /// marks its cells clear below the sensor (free_space_grid.hpp), so another robot's map
+  /// must not hold that desk's face as a wall standing there (free_space_conflict.hpp).
+  double min_rise_above_sensor_m = 0.1;
+  /// The sensor's height in the keyframe frame: LocalMapper sets it from T_base_lidar.
+  double sensor_height_m = 0.0;
   double covariance_floor_m = 0.01;  ///< per-axis floor on the measured covariance (sigma)
   Status Validate() const;
 };
