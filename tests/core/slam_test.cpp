@@ -261,6 +261,9 @@ TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
   EXPECT_GT(worst_odometry, 0.5);
   EXPECT_LT(worst, 0.05);
   EXPECT_GT(mapper.stats().scan_match_accepted, 25u);
+  // A closed room seen whole from every keyframe: its fitness is low, and the limit its floor.
+  EXPECT_DOUBLE_EQ(mapper.stats().scan_match_fitness_limit_m2, config.scan_match_max_fitness_m2);
+  EXPECT_EQ(mapper.stats().scan_match_above_floor, 0u);
   // Four walls, the floor and the ceiling; one four-wall room at the room's centre.
   std::size_t walls = 0, floors = 0;
   for (std::uint32_t p = 0; p < g.plane_slots(); ++p) {
@@ -319,6 +322,45 @@ double WorstAfterASlip(double motion_seed_max_age_s, LocalMapperStats& stats) {
   return worst;
 }
 
+// Steps [first, last) of the walk, one scan a second from t = 10 s, odometry bracketing each.
+void WalkSteps(LocalMapper& mapper, const Walk& walk, const LocalMapperConfig& config,
+               std::size_t first, std::size_t last) {
+  const std::vector<float> times(20000, 0.1f);  // every point taken at the end of the sweep
+  for (std::size_t i = first; i < last; ++i) {
+    const double t = 10.0 + static_cast<double>(i);
+    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
+    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
+    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
+    ASSERT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
+  }
+}
+
+// A sensor or building whose every fitness is above the configured floor: the first matches
+// are refused, the gate learns the robot's own fitnesses from them, and every later match is
+// accepted at the robot's own bound, so the map holds as it does with a floor that fits.
+TEST(LocalMapper, AFitnessFloorBelowEveryMatchIsWidenedByTheRobotsOwnMatches) {
+  LocalMapperConfig config = SmallConfig(64, 256);
+  config.scan_match_max_fitness_m2 = 1e-6;  // below any real fit at 0.2 m map sampling
+  config.scan_match_fitness_window = 20;
+  config.scan_match_fitness_outlier_z = 3.5;  // on (the default is off)
+  LocalMapper mapper;
+  ASSERT_TRUE(mapper.Init(config));
+  const Walk walk;
+  WalkSteps(mapper, walk, config, 0, walk.truth.size());
+  const LocalMapperStats& s = mapper.stats();
+  const FitnessGateConfig gate = config.scan_match_fitness_gate();
+  EXPECT_EQ(s.scan_match_rejected_fitness, gate.min_samples);  // until the gate has its figures
+  EXPECT_EQ(s.scan_match_accepted, walk.truth.size() - 1 - gate.min_samples);
+  EXPECT_EQ(s.scan_match_above_floor, s.scan_match_accepted);
+  EXPECT_GT(s.scan_match_fitness_limit_m2, config.scan_match_max_fitness_m2);
+  // With outlier_z 0 the floor is all there is, and nothing is ever matched.
+  config.scan_match_fitness_outlier_z = 0;
+  LocalMapper fixed;
+  ASSERT_TRUE(fixed.Init(config));
+  WalkSteps(fixed, walk, config, 0, walk.truth.size());
+  EXPECT_EQ(fixed.stats().scan_match_accepted, 0u);
+}
+
 TEST(LocalMapper, AFootSlipIsMatchedFromTheLastMatchsPace) {
   LocalMapperStats with{}, without{};
   const double worst_with = WorstAfterASlip(LocalMapperConfig{}.motion_seed_max_age_s, with);
@@ -349,13 +391,7 @@ TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
   ASSERT_TRUE(mapper.Init(config));
   const Walk walk(30, GetParam());
   std::vector<float> times(20000, 0.1f);
-  for (std::size_t i = 0; i <= 11; ++i) {
-    const double t = 10.0 + static_cast<double>(i);
-    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
-    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
-    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
-    ASSERT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
-  }
+  WalkSteps(mapper, walk, config, 0, 12);
   const SGraph& g = mapper.graph();
   const std::uint32_t last = static_cast<std::uint32_t>(g.keyframe_slots() - 1);
   const Eigen::Isometry3d T_map_odom =

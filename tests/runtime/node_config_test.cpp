@@ -71,9 +71,14 @@ TEST(NodeConfig, ReadsEveryKind) {
       Parse("[robot]\nid = 2\n[lidar]\nT_base_lidar = 0.1 0 0.3 0 0 90\n"
             "[collab]\nmode = rooms\ncloud = q8\n[link]\ndiscovery = unicast\n"
             "initial_peers = 10.0.0.2 10.0.0.3\nmax_kbytes_per_s = 250\n"
-            "[output]\ndir = out/r2\n",
+            "[output]\ndir = out/r2\n"
+            "[mapping]\nscan_match_max_fitness_m2 = 0.04\nscan_match_fitness_window = 50\n"
+            "scan_match_fitness_outlier_z = 3\n",
             c, error))
       << error;
+  EXPECT_DOUBLE_EQ(c.mapper.scan_match_max_fitness_m2, 0.04);
+  EXPECT_EQ(c.mapper.scan_match_fitness_window, 50u);
+  EXPECT_DOUBLE_EQ(c.mapper.scan_match_fitness_outlier_z, 3.0);
   EXPECT_NEAR(c.mapper.T_base_lidar.translation().x(), 0.1, 1e-12);
   const Eigen::Vector3d x_in_base = c.mapper.T_base_lidar.linear() * Eigen::Vector3d::UnitX();
   EXPECT_NEAR(x_in_base.y(), 1.0, 1e-9);  // yaw 90 degrees
@@ -108,6 +113,8 @@ TEST(NodeConfig, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(ErrorOf("[robot]\nid = 1\n[link]\nmax_kbytes_per_s = 5\n"),
             "robot.conf: [link] radio budget below 10 kB/s cannot carry a room cloud");
   EXPECT_EQ(ErrorOf("[robot]\nid = 1\n[led]\nline = 17\n"), "robot.conf: [led] line needs chip");
+  EXPECT_EQ(ErrorOf("[robot]\nid = 1\n[mapping]\nscan_match_fitness_window = 5\n"),
+            "robot.conf:4: mapping.scan_match_fitness_window: must be in [10, 100000], not 5");
 }
 
 TEST(NodeConfig, OverridesReplaceOrAddAndAreCheckedToo) {

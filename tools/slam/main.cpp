@@ -7,7 +7,12 @@
 // keyframe's stamp; how many keyframes it paired and why not the others) and the walls and
 // rooms found against the world's truth.
 //
+// --matches FILE writes every keyframe's scan match (CSV: the two stamps, the result, the fitness,
+// the fitness gate's limit, the transform) for tools/eval/match_errors.py to judge against the
+// truth; --fitness-floor and --fitness-outlier-z set the gate as the node's [mapping] keys do.
+//
 //   msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] [--max-keyframes N]
+//                 [--matches FILE] [--fitness-floor M2] [--fitness-outlier-z Z]
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -115,6 +120,8 @@ int main(int argc, char** argv) {
   int robot = 1;
   bool markdown = false, verbose = false;
   std::size_t max_keyframes = 0;
+  std::string matches_path;
+  double fitness_floor_m2 = -1, fitness_outlier_z = -1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--run" && i + 1 < argc)
@@ -125,6 +132,12 @@ int main(int argc, char** argv) {
       out_dir = argv[++i];
     else if (a == "--max-keyframes" && i + 1 < argc)
       max_keyframes = static_cast<std::size_t>(std::atol(argv[++i]));
+    else if (a == "--matches" && i + 1 < argc)
+      matches_path = argv[++i];
+    else if (a == "--fitness-floor" && i + 1 < argc)
+      fitness_floor_m2 = std::atof(argv[++i]);
+    else if (a == "--fitness-outlier-z" && i + 1 < argc)
+      fitness_outlier_z = std::atof(argv[++i]);
     else if (a == "--markdown")
       markdown = true;
     else if (a == "--verbose")
@@ -132,7 +145,8 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] "
-                   "[--max-keyframes N]\n");
+                   "[--max-keyframes N] [--matches FILE] [--fitness-floor M2] "
+                   "[--fitness-outlier-z Z]\n");
       return 2;
     }
   }
@@ -143,6 +157,17 @@ int main(int argc, char** argv) {
   }
   core::LocalMapperConfig config;
   if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;
+  if (fitness_floor_m2 >= 0) config.scan_match_max_fitness_m2 = fitness_floor_m2;
+  if (fitness_outlier_z >= 0) config.scan_match_fitness_outlier_z = fitness_outlier_z;
+  std::FILE* matches = nullptr;
+  if (!matches_path.empty()) {
+    matches = std::fopen(matches_path.c_str(), "w");
+    if (matches == nullptr) {
+      std::fprintf(stderr, "slam: cannot write %s\n", matches_path.c_str());
+      return 1;
+    }
+    std::fprintf(matches, "from_s,to_s,result,motion_seeded,fitness_m2,limit_m2,x,y,z,qx,qy,qz,qw\n");
+  }
   std::string world_error;
   std::optional<sim::World> world;
   if (fs::exists(fs::path(run) / "world.world"))
@@ -198,7 +223,15 @@ int main(int argc, char** argv) {
     feed_odometry_until(view.end_s + 0.05);
     const auto loops_before = mapper.loop_closer().stats().accepted;
     const auto rejected_before = mapper.loop_closer().stats().rejected_after_solve;
-    static_cast<void>(mapper.AddScan(view, &timer));
+    const auto outcome = mapper.AddScan(view, &timer);
+    const core::ScanMatchRecord& m = mapper.last_scan_match();
+    if (matches != nullptr && outcome && *outcome == core::ScanOutcome::kKeyframe && m.attempted) {
+      const Eigen::Quaterniond q(m.T_from_to.linear());
+      const Eigen::Vector3d t = m.T_from_to.translation();
+      std::fprintf(matches, "%.6f,%.6f,%s,%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.8f,%.8f,%.8f,%.8f\n",
+                   m.from_s, m.to_s, m.result, m.motion_seeded ? 1 : 0, m.fitness_m2, m.limit_m2,
+                   t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    }
     const auto& l = mapper.loop_closer().stats();
     if (verbose && l.accepted + l.rejected_after_solve != loops_before + rejected_before) {
       std::printf(
@@ -209,6 +242,10 @@ int main(int argc, char** argv) {
     }
   }
   static_cast<void>(mapper.Finish());
+  if (matches != nullptr && std::fclose(matches) != 0) {
+    std::fprintf(stderr, "slam: writing %s failed\n", matches_path.c_str());
+    return 1;
+  }
   const double seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
 
   // Outputs.
@@ -367,12 +404,14 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(gs.solves_undone));
   std::printf(
       "scan matching: %llu accepted; rejected fitness %llu, overlap %llu, diverged %llu, failed "
-      "%llu; odometry gaps at %llu keyframes, slips gated at %llu\n",
+      "%llu; %llu accepted above the fitness floor (limit now %.4f m^2); odometry gaps at %llu "
+      "keyframes, slips gated at %llu\n",
       static_cast<unsigned long long>(ms.scan_match_accepted),
       static_cast<unsigned long long>(ms.scan_match_rejected_fitness),
       static_cast<unsigned long long>(ms.scan_match_rejected_overlap),
       static_cast<unsigned long long>(ms.scan_match_rejected_diverged),
       static_cast<unsigned long long>(ms.scan_match_rejected_failed),
+      static_cast<unsigned long long>(ms.scan_match_above_floor), ms.scan_match_fitness_limit_m2,
       static_cast<unsigned long long>(ms.odometry_gap_keyframes),
       static_cast<unsigned long long>(ms.odometry_slips));
   const auto& ls = mapper.loop_closer().stats();

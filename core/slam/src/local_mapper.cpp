@@ -55,16 +55,26 @@ Status LocalMapperConfig::Validate() const {
   }
   for (const Status& s :
        {graph.Validate(), planes.Validate(), association.Validate(), rooms.Validate(),
-        grid.Validate(), loops.Validate(), scan_matching.Validate()}) {
+        grid.Validate(), loops.Validate(), scan_matching.Validate(),
+        scan_match_fitness_gate().Validate()}) {
     if (!s) return s;
   }
   return Ok();
+}
+
+FitnessGateConfig LocalMapperConfig::scan_match_fitness_gate() const {
+  FitnessGateConfig gate;
+  gate.floor_m2 = scan_match_max_fitness_m2;
+  gate.window = scan_match_fitness_window;
+  gate.outlier_z = scan_match_fitness_outlier_z;
+  return gate;
 }
 
 Status LocalMapper::Init(const LocalMapperConfig& config) {
   if (auto s = config.Validate(); !s) return s;
   config_ = config;
   if (auto s = graph_.Init(config.graph); !s) return s;
+  if (auto s = fitness_gate_.Init(config.scan_match_fitness_gate()); !s) return s;
   odometry_.Init(config.odometry_capacity, config.odometry_max_gap_s);
   const std::size_t slots = config.graph.max_keyframes + 1;
   clouds_.Init(slots, config.cloud_store_points);
@@ -219,7 +229,10 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   bool matched = false;
   Eigen::Isometry3d T_last_new = delta;
   Matrix6d match_information = Matrix6d::Identity();
+  last_match_ = {};
   if (have_keyframe_ && BuildLocalMap(last_keyframe_)) {
+    fitness_limit_m2_ = fitness_gate_.Limit();
+    stats_.scan_match_fitness_limit_m2 = fitness_limit_m2_;
     double fitness_m2 = 0;
     MatchOutcome outcome = MatchFrom(delta, T_last_new, match_information, fitness_m2);
     // A step whose odometry disagrees with the pace the last match measured may be a slip:
@@ -236,10 +249,19 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
       outcome = MatchOutcome::kAccepted;
       T_last_new = T_motion;
       match_information = motion_information;
+      fitness_m2 = motion_fitness_m2;
+      last_match_.motion_seeded = true;
     }
+    last_match_.attempted = true;
+    last_match_.from_s = graph_.keyframe_stamp(last_keyframe_);
+    last_match_.to_s = scan.end_s;
+    last_match_.fitness_m2 = fitness_m2;
+    last_match_.limit_m2 = fitness_limit_m2_;
+    last_match_.T_from_to = T_last_new;
     switch (outcome) {
       case MatchOutcome::kAccepted:
         matched = true;
+        if (fitness_m2 > config_.scan_match_max_fitness_m2) ++stats_.scan_match_above_floor;
         T_map_new = graph_.keyframe_pose(last_keyframe_) * T_last_new;
         ++stats_.scan_match_accepted;
         break;
@@ -248,6 +270,11 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
       case MatchOutcome::kOverlap: ++stats_.scan_match_rejected_overlap; break;
       case MatchOutcome::kDiverged: ++stats_.scan_match_rejected_diverged; break;
     }
+    last_match_.result = ToString(outcome);
+    // The gate learns from every converged match it judged, refused ones too: a sensor or a
+    // building whose every fitness is above the floor would otherwise never be matched at all.
+    if (outcome == MatchOutcome::kAccepted || outcome == MatchOutcome::kFitness)
+      fitness_gate_.Add(fitness_m2);
   } else if (have_keyframe_) {
     ++stats_.scan_match_rejected_failed;
   }
@@ -349,6 +376,17 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   return ScanOutcome::kKeyframe;
 }
 
+const char* LocalMapper::ToString(MatchOutcome outcome) {
+  switch (outcome) {
+    case MatchOutcome::kAccepted: return "accepted";
+    case MatchOutcome::kFailed: return "failed";
+    case MatchOutcome::kFitness: return "fitness";
+    case MatchOutcome::kOverlap: return "overlap";
+    case MatchOutcome::kDiverged: return "diverged";
+  }
+  return "none";
+}
+
 LocalMapper::MatchOutcome LocalMapper::MatchFrom(const Eigen::Isometry3d& T_last_seed,
                                                  Eigen::Isometry3d& T_last_new,
                                                  Matrix6d& information, double& fitness_m2) {
@@ -356,7 +394,7 @@ LocalMapper::MatchOutcome LocalMapper::MatchFrom(const Eigen::Isometry3d& T_last
                              local_tree_, T_last_seed, config_.scan_matching);
   if (!result || !result->converged) return MatchOutcome::kFailed;
   fitness_m2 = result->fitness;
-  if (result->fitness > config_.scan_match_max_fitness_m2) return MatchOutcome::kFitness;
+  if (result->fitness > fitness_limit_m2_) return MatchOutcome::kFitness;
   if (static_cast<double>(result->correspondences) <
       config_.scan_match_min_overlap * static_cast<double>(down_.size())) {
     return MatchOutcome::kOverlap;

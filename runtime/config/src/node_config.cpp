@@ -244,6 +244,10 @@ bool ParseNodeConfig(const std::string& text,
   c.mapper.grid.width = c.mapper.grid.height = cells;
   c.mapper.grid.origin_m = Eigen::Vector2f::Constant(-0.5f * static_cast<float>(cells) * c.mapper.grid.resolution_m);
   r.Bool("mapping", "grid_follows_robot", c.mapper.grid_follows_robot);
+  // Scan matching's fitness limit: a floor, widened to the robot's own outlier bound (FitnessGate).
+  r.Number("mapping", "scan_match_max_fitness_m2", 1e-4, 10.0, c.mapper.scan_match_max_fitness_m2);
+  r.Integer("mapping", "scan_match_fitness_window", 10, 100000, c.mapper.scan_match_fitness_window);
+  r.Number("mapping", "scan_match_fitness_outlier_z", 0.0, 100.0, c.mapper.scan_match_fitness_outlier_z);
 
   int mode = 3;
   r.Choice("collab", "mode", kModes, mode);

@@ -37,6 +37,7 @@
 #include "msgraphs/core/registration/vgicp.hpp"
 #include "msgraphs/core/slam/keyframe_cloud_store.hpp"
 #include "msgraphs/core/slam/loop_closer.hpp"
+#include "msgraphs/core/slam/fitness_gate.hpp"
 #include "msgraphs/core/slam/odometry_buffer.hpp"
 #include "msgraphs/core/slam/plane_mapper.hpp"
 #include "msgraphs/core/slam/room_mapper.hpp"
@@ -63,7 +64,15 @@ struct LocalMapperConfig {
   std::size_t local_map_keyframes = 10;
   double local_map_resolution_m = 0.4;  ///< VGICP voxels of the local map
   double scan_match_sigma_m = 0.02;     ///< strongest direction; the Hessian gives the rest
+  /// The fitness limit (and relocalisation's). With scan_match_fitness_outlier_z > 0 it is a
+  /// floor, widened to the upper outlier bound of the robot's own last
+  /// scan_match_fitness_window match fitnesses (FitnessGate; 3.5 is the modified z-score rule's
+  /// value). Off by default: on the benchmark it rescued slipped steps but let through as many
+  /// matches 6-20 cm off, and the maps came out worse at the median (docs/s-graph.md, "Fitness
+  /// gate"). A robot whose every fit is above the limit (a noisier sensor) turns it on.
   double scan_match_max_fitness_m2 = 0.05;
+  std::size_t scan_match_fitness_window = 100;
+  double scan_match_fitness_outlier_z = 0.0;
   double scan_match_min_overlap = 0.5;
   double max_correction_m = 0.25;   ///< scan matching may move the odometry's guess this much
   double max_correction_rad = 0.1;  ///< ...and turn it this much, else it diverged
@@ -113,6 +122,7 @@ struct LocalMapperConfig {
   /// the local map cannot contain, and that is not misalignment.
   VgicpConfig scan_matching = VgicpWithFitnessWithin(1.0);
   Status Validate() const;
+  [[nodiscard]] FitnessGateConfig scan_match_fitness_gate() const;
 };
 
 /// One assembled sweep: points in the lidar frame with their time after `start_s`.
@@ -145,6 +155,18 @@ class StageObserver {
   virtual void StageEnded(MapperStage stage) = 0;
 };
 
+/// The newest keyframe's scan match, for evaluation against the truth (msgraphs_slam --matches).
+struct ScanMatchRecord {
+  bool attempted = false;       ///< false: the first keyframe, or no local map
+  double from_s = 0, to_s = 0;  ///< the previous keyframe's stamp and this one's
+  const char* result = "none";  ///< accepted | failed | fitness | overlap | diverged | none
+  bool motion_seeded = false;   ///< accepted from the last match's pace (motion seed)
+  double fitness_m2 = 0;        ///< the kept attempt's (0 where VGICP failed)
+  double limit_m2 = 0;          ///< the fitness gate's limit at this keyframe
+  /// Accepted: the match (previous keyframe to this one, base frames); else the odometry's step.
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();
+};
+
 struct LocalMapperStats {
   std::uint64_t scans = 0, keyframes = 0;
   std::uint64_t no_odometry = 0;  ///< scan outside the odometry buffered (skipped, counted)
@@ -158,6 +180,10 @@ struct LocalMapperStats {
   /// them `preferred` where the odometry's guess was accepted too but fitted worse; the
   /// rejections above count odometry-seeded attempts that the motion's guess did not save.
   std::uint64_t scan_match_motion_seeded = 0, scan_match_motion_preferred = 0;
+  /// Of the accepted: fitter than the floor allows, let through by the robot's own outlier
+  /// bound (FitnessGate); and that bound at the newest keyframe.
+  std::uint64_t scan_match_above_floor = 0;
+  double scan_match_fitness_limit_m2 = 0;
   std::uint64_t loop_closures = 0, full_solves = 0;
   /// Keyframes the graph refused (its store full with nothing to sparsify, which a validated
   /// config rules out): the scan is skipped and the next one tries again.
@@ -247,6 +273,7 @@ class LocalMapper {
                                                 : Eigen::Isometry3d::Identity();
   }
   const LocalMapperStats& stats() const { return stats_; }
+  const ScanMatchRecord& last_scan_match() const { return last_match_; }
   const PlaneMapper& plane_mapper() const { return planes_mapper_; }
   const RoomMapper& room_mapper() const { return rooms_; }
   const LoopCloser& loop_closer() const { return loops_; }
@@ -273,6 +300,7 @@ class LocalMapper {
   double SeedScore(const Eigen::Isometry3d& T_last_seed) const;
   Matrix6d OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const;
   enum class MatchOutcome : std::uint8_t { kAccepted, kFailed, kFitness, kOverlap, kDiverged };
+  static const char* ToString(MatchOutcome outcome);
   /// The keyframe scan (down_) against the local map from `T_last_seed`; on acceptance the
   /// registered step and its information.
   MatchOutcome MatchFrom(const Eigen::Isometry3d& T_last_seed, Eigen::Isometry3d& T_last_new,
@@ -295,6 +323,9 @@ class LocalMapper {
   KdTree tree_, local_tree_;
   GaussianVoxelMap local_map_;
   Vgicp vgicp_;
+  FitnessGate fitness_gate_;
+  ScanMatchRecord last_match_;
+  double fitness_limit_m2_ = 0;  ///< this keyframe's, for both seeds
   BoundedVector<Eigen::Vector3f> work_, filtered_, down_, normals_, stored_, local_raw_,
       local_points_, local_normals_, world_points_;
   BoundedVector<Eigen::Matrix3f> covariances_, local_covariances_;
