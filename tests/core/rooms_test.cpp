@@ -181,6 +181,66 @@ TEST(Rooms, AWideOpeningBetweenCollinearWallPiecesStillSeparatesRooms) {
   }
 }
 
+// The openings closure at the generator's extremes (docs/perception.md, "Openings"): its
+// doorless openings reach 3.0 m and its corridors narrow to 1.8 m, on either side of the 2.2 m
+// default, so each side's outcome is pinned here.
+std::size_t RegionsOf(const Plan& plan, const std::vector<MapWall>& walls, const std::vector<Eigen::Vector2d>& at,
+                      float close_openings_up_to_m) {
+  FreeSpaceGridConfig gc;
+  gc.width = gc.height = 300;
+  gc.origin_m = {-5, -10};
+  FreeSpaceGrid grid;
+  EXPECT_TRUE(grid.Init(gc));
+  Scan(grid, plan, at);
+  RoomSegmenter segmenter;
+  EXPECT_TRUE(segmenter.Init(300, 300, 16, 16));
+  BoundedVector<RoomRegion> regions(16);
+  RoomSegmentationConfig config;
+  config.close_openings_up_to_m = close_openings_up_to_m;
+  EXPECT_TRUE(segmenter.Segment(grid, config, regions, walls));
+  return regions.size();
+}
+
+TEST(Rooms, AThreeMetreDoorlessOpeningJoinsTwoHallsUnlessTheClosureReachesIt) {
+  Plan plan;  // the halls of the test above, joined by 3 m (x = 8, y 1.5..4.5)
+  plan.Face(0, 0, 16, 0);
+  plan.Face(0, 6, 16, 6);
+  plan.Face(0, 0, 0, 6);
+  plan.Face(16, 0, 16, 6);
+  plan.Face(8, 0, 8, 1.5);
+  plan.Face(8, 4.5, 8, 6);
+  const Eigen::Vector2d px(1, 0), nx(-1, 0), py(0, 1), ny(0, -1);
+  const std::vector<MapWall> walls = {Wall(plan, 0, 0, 0, 16, 0, py), Wall(plan, 1, 0, 6, 16, 6, ny),
+                                      Wall(plan, 2, 0, 0, 0, 6, px),  Wall(plan, 3, 16, 0, 16, 6, nx),
+                                      Wall(plan, 4, 8, 0, 8, 1.5, nx), Wall(plan, 5, 8, 4.5, 8, 6, nx)};
+  const std::vector<Eigen::Vector2d> at = {{2, 2}, {6, 4}, {4, 3}, {10, 2}, {14, 4}, {12, 3}, {8, 3}};
+  EXPECT_EQ(RegionsOf(plan, walls, at, RoomSegmentationConfig{}.close_openings_up_to_m), 1u)
+      << "at the default, a 3 m opening leaves one larger region (never a wrong room)";
+  EXPECT_EQ(RegionsOf(plan, walls, at, 3.2f), 2u) << "a closure configured past it separates the halls";
+}
+
+TEST(Rooms, ACorridorNarrowerThanTheClosureIsCutWherePartitionsLineUpAcrossIt) {
+  // A 1.8 m corridor (y 0..1.8, x 0..16) between two rows of two closed 8 x 5 m rooms whose
+  // partitions (x = 8) line up across it.
+  Plan plan;
+  plan.Face(0, -5, 16, -5);
+  plan.Face(0, 6.8, 16, 6.8);
+  plan.Face(0, -5, 0, 6.8);
+  plan.Face(16, -5, 16, 6.8);
+  plan.Face(0, 0, 16, 0);
+  plan.Face(0, 1.8, 16, 1.8);
+  plan.Face(8, -5, 8, 0);
+  plan.Face(8, 1.8, 8, 6.8);
+  const Eigen::Vector2d px(1, 0), py(0, 1), ny(0, -1);
+  const std::vector<MapWall> walls = {Wall(plan, 0, 0, 0, 16, 0, py), Wall(plan, 1, 0, 1.8, 16, 1.8, ny),
+                                      Wall(plan, 2, 8, -5, 8, 0, px), Wall(plan, 3, 8, 1.8, 8, 6.8, px)};
+  const std::vector<Eigen::Vector2d> at = {{2, 0.9}, {6, 0.9}, {10, 0.9}, {14, 0.9}, {4, -2.5},
+                                           {12, -2.5}, {4, 4.3}, {12, 4.3}};
+  EXPECT_EQ(RegionsOf(plan, walls, at, RoomSegmentationConfig{}.close_openings_up_to_m), 6u)
+      << "four rooms and the corridor in two pieces at the default";
+  EXPECT_EQ(RegionsOf(plan, walls, at, 1.6f), 5u) << "a closure below the corridor's width keeps it whole";
+}
+
 TEST(Rooms, EmptyGridsAndRoomlessInputGiveNothingAndNoCrash) {
   FreeSpaceGridConfig gc;
   gc.width = gc.height = 100;

@@ -73,12 +73,15 @@ TEST(NodeConfig, ReadsEveryKind) {
             "initial_peers = 10.0.0.2 10.0.0.3\nmax_kbytes_per_s = 250\n"
             "[output]\ndir = out/r2\n"
             "[mapping]\nscan_match_max_fitness_m2 = 0.04\nscan_match_fitness_window = 50\n"
-            "scan_match_fitness_outlier_z = 3\n",
+            "scan_match_fitness_outlier_z = 3\n"
+            "[rooms]\ndoor_cut_clearance_m = 0.6\nclose_openings_up_to_m = 1.6\n",
             c, error))
       << error;
   EXPECT_DOUBLE_EQ(c.mapper.scan_match_max_fitness_m2, 0.04);
   EXPECT_EQ(c.mapper.scan_match_fitness_window, 50u);
   EXPECT_DOUBLE_EQ(c.mapper.scan_match_fitness_outlier_z, 3.0);
+  EXPECT_FLOAT_EQ(c.mapper.rooms.segmentation.door_cut_clearance_m, 0.6f);
+  EXPECT_FLOAT_EQ(c.mapper.rooms.segmentation.close_openings_up_to_m, 1.6f);
   EXPECT_NEAR(c.mapper.T_base_lidar.translation().x(), 0.1, 1e-12);
   const Eigen::Vector3d x_in_base = c.mapper.T_base_lidar.linear() * Eigen::Vector3d::UnitX();
   EXPECT_NEAR(x_in_base.y(), 1.0, 1e-9);  // yaw 90 degrees
@@ -115,6 +118,8 @@ TEST(NodeConfig, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(ErrorOf("[robot]\nid = 1\n[led]\nline = 17\n"), "robot.conf: [led] line needs chip");
   EXPECT_EQ(ErrorOf("[robot]\nid = 1\n[mapping]\nscan_match_fitness_window = 5\n"),
             "robot.conf:4: mapping.scan_match_fitness_window: must be in [10, 100000], not 5");
+  EXPECT_EQ(ErrorOf("[robot]\nid = 1\n[rooms]\nclose_openings_up_to_m = -1\n"),
+            "robot.conf:4: rooms.close_openings_up_to_m: must be in [0, 10], not -1");
 }
 
 TEST(NodeConfig, OverridesReplaceOrAddAndAreCheckedToo) {

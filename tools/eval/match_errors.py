@@ -63,12 +63,23 @@ class Truth:
                 self.p.append(v[1:8])
         if len(self.t) < 2:
             raise ValueError(f"{path}: fewer than two truth samples")
+        if any(b <= a for a, b in zip(self.t, self.t[1:])):
+            raise ValueError(f"{path}: truth stamps are not increasing")
+        # The pairing rule of tools/include/msgraphs/tools/truth_pairing.hpp: bracketing samples
+        # further apart than 2.5 of the truth's own median periods are a gap, not interpolated.
+        periods = sorted(b - a for a, b in zip(self.t, self.t[1:]))
+        self.gap_limit_s = 2.5 * periods[len(periods) // 2]
 
     def at(self, s):
         i = bisect.bisect_left(self.t, s)
+        if i < len(self.t) and self.t[i] == s:
+            p = self.p[i]
+            return pose(quat_to_matrix(*p[3:]), p[:3])
         if i <= 0 or i >= len(self.t):
             return None
         t0, t1 = self.t[i - 1], self.t[i]
+        if t1 - t0 > self.gap_limit_s:
+            return None
         a = (s - t0) / (t1 - t0) if t1 > t0 else 0.0
         p0, p1 = self.p[i - 1], self.p[i]
         xyz = [p0[k] + a * (p1[k] - p0[k]) for k in range(3)]
@@ -121,7 +132,7 @@ def main():
                 listed.append((mpath, float(r["to_s"]), err_m, fit, limit))
             else:
                 correct.append(fit)
-    print(f"accepted matches judged: {len(correct) + len(wrong)} ({unpaired} outside the truth); "
+    print(f"accepted matches judged: {len(correct) + len(wrong)} ({unpaired} outside the truth or in its gaps); "
           f"refused by fitness: {refused_fitness} (not judged: they keep the odometry's step)")
     for name, v in (("correct", correct), (f"wrong (> {args.wrong_m} m)", wrong)):
         print(f"  {name}: {len(v)}; fitness m^2 median {percentile(v, 0.5):.4f} p90 "

@@ -248,6 +248,11 @@ bool ParseNodeConfig(const std::string& text,
   r.Number("mapping", "scan_match_max_fitness_m2", 1e-4, 10.0, c.mapper.scan_match_max_fitness_m2);
   r.Integer("mapping", "scan_match_fitness_window", 10, 100000, c.mapper.scan_match_fitness_window);
   r.Number("mapping", "scan_match_fitness_outlier_z", 0.0, 100.0, c.mapper.scan_match_fitness_outlier_z);
+  // Room segmentation (RoomSegmentationConfig): the building's doorways and corridors, not the
+  // simulator's. An opening narrower than close_openings_up_to_m is closed before segmenting; it
+  // must stay below the building's narrowest corridor (docs/perception.md, "Openings").
+  r.Float("rooms", "door_cut_clearance_m", 0.1, 5.0, c.mapper.rooms.segmentation.door_cut_clearance_m);
+  r.Float("rooms", "close_openings_up_to_m", 0.0, 10.0, c.mapper.rooms.segmentation.close_openings_up_to_m);
 
   int mode = 3;
   r.Choice("collab", "mode", kModes, mode);
