@@ -5,12 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "msgraphs/base/bounded_vector.hpp"
+#include "msgraphs/base/crc32.hpp"
 #include "msgraphs/base/fixed_vector.hpp"
 #include "msgraphs/base/ring_buffer.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
@@ -89,6 +93,37 @@ TEST(AllocCounter, ZeroForANonAllocatingSteadyStateLoop) {
   }
   DoNotOptimize(checksum);
   EXPECT_EQ(scope.allocations(), 0u);
+}
+
+// Bit by bit, for comparison with the table-driven one.
+std::uint32_t BitwiseCrc32(std::span<const std::uint8_t> bytes) {
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (const std::uint8_t b : bytes) {
+    c ^= b;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) != 0 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+  }
+  return c ^ 0xFFFFFFFFu;
+}
+
+// crc32.hpp: "never allocates"; and it is the IEEE 802.3 CRC-32 (its check value).
+TEST(Crc32, IsTheIeeeCrcAndNeverAllocates) {
+  const std::array<std::uint8_t, 9> check = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+  std::vector<std::uint8_t> message(64 * 1024);
+  for (std::size_t i = 0; i < message.size(); ++i) message[i] = static_cast<std::uint8_t>(i * 31 + 7);
+  const std::uint32_t expected = BitwiseCrc32(message);
+
+  AllocationScope scope;
+  const std::uint32_t check_crc = Crc32(check);
+  const std::uint32_t empty_crc = Crc32(std::span<const std::uint8_t>());
+  std::uint32_t message_crc = 0;
+  for (int pass = 0; pass < 100; ++pass) message_crc = Crc32(message);
+  const std::uint64_t allocations = scope.allocations();
+
+  DoNotOptimize(message_crc);
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(check_crc, 0xCBF43926u);
+  EXPECT_EQ(empty_crc, 0u);
+  EXPECT_EQ(message_crc, expected);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "msgraphs/base/byte_order.hpp"
 #include "msgraphs/base/crc32.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
@@ -474,6 +475,20 @@ TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
   std::vector<std::uint8_t> buffer(4096);
   EXPECT_EQ(*EncodeDistilled(g, g.version, buffer),
             kDistilledHeaderBytes + 4);  // no floor in this graph
+  // Without marginals, distilling and encoding allocate nothing (distiller.hpp,
+  // distilled_codec.hpp); with them, ceres::Covariance does (SGraph::PlaneMarginals).
+  DistillerConfig conditional;
+  conditional.marginal_covariances = false;
+  Distiller plain;
+  ASSERT_TRUE(plain.Init(1, graph_config, conditional));
+  {
+    test::AllocationScope scope;
+    EXPECT_TRUE(plain.Update(graph, planes));
+    EXPECT_FALSE(plain.Update(graph, planes));
+    EXPECT_TRUE(EncodeDistilled(plain.graph(), 0, buffer));
+    EXPECT_EQ(scope.allocations(), 0u);
+  }
+  EXPECT_EQ(plain.graph().walls.size(), 4u);
 }
 
 }  // namespace

@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: MIT
 // The free-space summary's openings: where a robot saw through one of its own walls, and only
-// there.
+// there; and Build and Decode allocate nothing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <span>
 #include <vector>
 
+#include "alloc_counter.hpp"
+#include "msgraphs/core/collab/free_space_codec.hpp"
 #include "msgraphs/core/collab/free_space_summary.hpp"
 
 namespace msgraphs::core {
@@ -91,6 +96,48 @@ TEST(FreeSpaceSummary, AWallSeenEdgeOnIsNoOpening) {
   const std::vector<Eigen::Vector3f> grazing(100, Eigen::Vector3f(9.5f, 0, 0.5f));
   grid.Integrate(in_line, grazing, 0.0f);
   ExpectOnlyTheDoor(Openings(grid));
+}
+
+// free_space_summary.hpp: "Build and Decode allocate nothing". The grid, both summaries (Init)
+// and the message buffer are set up first; the first Build and the first Decode are counted.
+TEST(FreeSpaceSummary, BuildAndDecodeAllocateNothing) {
+  FreeSpaceGrid grid = Grid();
+  LookFromBothSides(grid);
+  const DistilledWall wall = TheWall();
+  FreeSpaceSummary summary;
+  ASSERT_TRUE(summary.Init({}));
+  FreeSpaceSummary received;
+  ASSERT_TRUE(received.Init({}));
+  std::vector<std::uint8_t> bytes(1 << 20);
+
+  std::uint64_t build_allocations = 0;
+  {
+    test::AllocationScope scope;
+    const Status built = summary.Build(grid, std::span<const DistilledWall>(&wall, 1));
+    build_allocations = scope.allocations();
+    ASSERT_TRUE(built) << built.error().detail;
+  }
+  EXPECT_EQ(build_allocations, 0u);
+  EXPECT_GT(summary.free_cells(), 0u);
+  ExpectOnlyTheDoor(std::vector<Opening>(summary.openings().begin(), summary.openings().end()));
+
+  const Expected<std::size_t> n = EncodeFreeSpace({3, 9}, summary, bytes);
+  ASSERT_TRUE(n) << n.error().detail;
+  const std::span<const std::uint8_t> message(bytes.data(), *n);
+  std::uint64_t decode_allocations = 0;
+  {
+    test::AllocationScope scope;
+    const Expected<FreeSpaceHeader> header = DecodeFreeSpace(message, received);
+    decode_allocations = scope.allocations();
+    ASSERT_TRUE(header) << header.error().detail;
+    EXPECT_EQ(header->robot, 3);
+    EXPECT_EQ(header->version, 9u);
+  }
+  EXPECT_EQ(decode_allocations, 0u);
+  ASSERT_EQ(received.cells(), summary.cells());
+  EXPECT_TRUE(std::equal(received.raw().begin(), received.raw().end(), summary.raw().begin()));
+  EXPECT_EQ(received.free_cells(), summary.free_cells());
+  EXPECT_EQ(received.openings().size(), summary.openings().size());
 }
 
 }  // namespace

@@ -201,6 +201,38 @@ TEST(MergeRule, AMergeContradictedLaterIsOverturned) {
   ExpectNear(d.leader.T_a_b, truth);
 }
 
+// Rule 5 with the conflict charged (merge_rule.cpp): benchmark m023's figures. A robot whose
+// own map slipped leaves 2.4 m of its walls in the other's free space under the true transform
+// (154 m of agreement, 37 m in its weakest direction), which refutes it; a half-turned
+// hypothesis with 61 m (26 m) stands unrefuted. The truth beats it by the margin net of its
+// conflict and is no weaker in its weakest direction, though not by the margin there: the pair
+// stays undecided, not merged half round.
+TEST(MergeRule, ATruthRefutedByALittleStillBlocksAMuchWeakerLeader) {
+  Hypothesis truth, half_turn;
+  truth.T_a_b = {0.1, Eigen::Vector2d(3, 4)};
+  truth.agreement.agreement_m = 154.3;
+  truth.agreement.constraint_m = 37.3;
+  truth.conflict_known = true;
+  truth.conflict_b_in_a.walls_in_free_m = 2.4;
+  half_turn.T_a_b = {0.1 + kPi, Eigen::Vector2d(-14, 9)};
+  half_turn.agreement.agreement_m = 60.9;
+  half_turn.agreement.constraint_m = 25.9;
+  half_turn.conflict_known = true;
+  std::vector<Hypothesis> hypotheses = {truth, half_turn};
+  MergeInputs in;
+  in.hypotheses = hypotheses;
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  const MergeRuleConfig config;
+  ASSERT_GT(truth.conflict_m(), config.RefuteLimit(truth)) << "the truth is refuted";
+  ASSERT_LT(truth.agreement.constraint_m, config.margin_ratio * half_turn.agreement.constraint_m + config.margin_m)
+      << "the weakest direction alone would not have blocked it";
+  const MergeDecision d = DecideMerge(in, search, config, nullptr);
+  EXPECT_EQ(d.verdict, MergeVerdict::kContradicted) << ToString(d.verdict);
+  ASSERT_TRUE(d.has_best_refuted);
+  EXPECT_DOUBLE_EQ(d.best_refuted.agreement.agreement_m, 154.3);
+}
+
 TEST(MergeRule, DecidingAllocatesNothing) {
   const PlanBuilding building = VariedRooms();
   Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));
@@ -212,6 +244,13 @@ TEST(MergeRule, DecidingAllocatesNothing) {
   const MergeDecision d = Decide(a, b, search);
   EXPECT_EQ(scope.allocations(), 0u);
   EXPECT_EQ(d.verdict, MergeVerdict::kMerge);
+}
+
+void ExpectSameSummary(const FreeSpaceSummary& back, const FreeSpaceSummary& sent) {
+  ASSERT_EQ(back.cells(), sent.cells());
+  EXPECT_TRUE(std::equal(back.raw().begin(), back.raw().end(), sent.raw().begin()));
+  EXPECT_EQ(back.openings().size(), sent.openings().size());
+  EXPECT_EQ(back.free_cells(), sent.free_cells());
 }
 
 TEST(FreeSpaceCodec, RoundTripAndRefusals) {
@@ -230,10 +269,7 @@ TEST(FreeSpaceCodec, RoundTripAndRefusals) {
   ASSERT_TRUE(h);
   EXPECT_EQ(h->robot, 7);
   EXPECT_EQ(h->version, 42u);
-  ASSERT_EQ(back.cells(), a.free.cells());
-  EXPECT_TRUE(std::equal(back.raw().begin(), back.raw().end(), a.free.raw().begin()));
-  EXPECT_EQ(back.openings().size(), a.free.openings().size());
-  EXPECT_EQ(back.free_cells(), a.free.free_cells());
+  ExpectSameSummary(back, a.free);
   // Every byte flipped somewhere is refused (CRC), truncations are refused, a re-sealed body with
   // a wrong run count is refused.
   for (std::size_t i = 0; i < bytes.size(); i += 7) {
@@ -251,6 +287,71 @@ TEST(FreeSpaceCodec, RoundTripAndRefusals) {
   auto e = DecodeFreeSpace(bytes, small);
   ASSERT_FALSE(e);
   EXPECT_EQ(e.error().code, Errc::kCapacityExceeded);
+}
+
+// free_space_codec.hpp: encoding and decoding allocate nothing, a refused message included. The
+// summaries (Init) and the buffer are set up first.
+TEST(FreeSpaceCodec, EncodingAndDecodingAllocateNothing) {
+  const PlanBuilding building = VariedRooms();
+  Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));
+  std::vector<std::uint8_t> bytes(1 << 20);
+  FreeSpaceSummary back;
+  FreeSpaceSummaryConfig fc;
+  fc.max_cells = 1 << 19;
+  ASSERT_TRUE(back.Init(fc));
+
+  test::AllocationScope scope;
+  const Expected<std::size_t> n = EncodeFreeSpace({7, 42}, a.free, bytes);
+  ASSERT_TRUE(n);
+  const std::span<const std::uint8_t> message(bytes.data(), *n);
+  const Expected<FreeSpaceHeader> refused = DecodeFreeSpace(message.first(message.size() - 1), back);
+  const Expected<FreeSpaceHeader> h = DecodeFreeSpace(message, back);
+  const std::uint64_t allocations = scope.allocations();
+
+  EXPECT_EQ(allocations, 0u);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, Errc::kChecksum);
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->robot, 7);
+  EXPECT_EQ(h->version, 42u);
+  ExpectSameSummary(back, a.free);
+}
+
+// wall_index.hpp: "Build and the queries allocate nothing", also when more walls come than fit
+// (the longest are kept). Both indexes are sized first (Init).
+TEST(WallIndex, BuildAndQueriesAllocateNothing) {
+  const PlanBuilding building = VariedRooms();
+  // The corridor up to x = 14 (3 faces) and rooms 1-3 (4 faces each), all at least 2.4 m long.
+  const DistilledGraph graph = building.Walls({{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));
+  ASSERT_EQ(graph.walls.size(), 15u);
+  WallIndex every, longest;
+  ASSERT_TRUE(every.Init(256));
+  ASSERT_TRUE(longest.Init(4));
+
+  test::AllocationScope scope;
+  every.Build(graph.walls.span(), 0.5);
+  longest.Build(graph.walls.span(), 0.5);
+  // Every wall finds itself: same normal, same offset.
+  std::size_t found_themselves = 0, visits = 0;
+  for (const AlignWall& w : every.walls()) {
+    bool self = false;
+    every.ForEachNear(w.n, w.d, 0.02, 0.05, [&](const AlignWall& other) {
+      ++visits;
+      self = self || other.id == w.id;
+    });
+    if (self) ++found_themselves;
+  }
+  const std::uint64_t allocations = scope.allocations();
+
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(every.walls().size(), 15u);
+  EXPECT_EQ(every.dropped(), 0u);
+  EXPECT_EQ(found_themselves, 15u);
+  EXPECT_GE(visits, 15u);
+  // The four longest: the corridor's two 14 m faces and two 4.85 m faces of the rooms.
+  ASSERT_EQ(longest.walls().size(), 4u);
+  EXPECT_EQ(longest.dropped(), 11u);
+  for (const AlignWall& w : longest.walls()) EXPECT_GT(w.length_m, 4.8);
 }
 
 }  // namespace

@@ -104,6 +104,42 @@ TEST(Vgicp, RecoversAKnownTransform) {
   ASSERT_TRUE(again.has_value());
 }
 
+// gaussian_voxel_map.hpp: "Bounded hash map sized at Init; Build allocates nothing", the first
+// Build, a rebuild at another resolution and an overflowing one alike. The clouds and both maps
+// (Init) are set up first.
+TEST(GaussianVoxelMap, BuildAllocatesNothing) {
+  Prepared target(60000);
+  target.From(Scene(10, Eigen::Isometry3d::Identity()), 0.1f);
+  ASSERT_GT(target.points.size(), 1000u);
+  GaussianVoxelMap map, tiny;
+  map.Init(50000);
+  tiny.Init(10);
+
+  test::AllocationScope scope;
+  const Status coarse = map.Build(target.points.span(), target.covs.span(), 1.0);
+  const std::size_t coarse_voxels = map.voxels();
+  const Status fine = map.Build(target.points.span(), target.covs.span(), 0.5);
+  const Status overflow = tiny.Build(target.points.span(), target.covs.span(), 0.5);
+  const GaussianVoxel* hit = map.Lookup(target.points[0].cast<double>());
+  const GaussianVoxel* miss = map.Lookup(Eigen::Vector3d(500, 500, 500));
+  const std::uint64_t allocations = scope.allocations();
+
+  EXPECT_EQ(allocations, 0u);
+  ASSERT_TRUE(coarse) << coarse.error().detail;
+  ASSERT_TRUE(fine) << fine.error().detail;
+  // Finer voxels: more of them, each still aggregating several points.
+  EXPECT_GT(coarse_voxels, 0u);
+  EXPECT_GT(map.voxels(), coarse_voxels);
+  EXPECT_LT(map.voxels(), target.points.size());
+  ASSERT_NE(hit, nullptr);
+  EXPECT_GT(hit->points, 0u);
+  EXPECT_LT((hit->mean - target.points[0].cast<double>()).cwiseAbs().maxCoeff(), 0.5 + 1e-6);
+  EXPECT_EQ(miss, nullptr);
+  ASSERT_FALSE(overflow);
+  EXPECT_EQ(overflow.error().code, Errc::kCapacityExceeded);
+  EXPECT_EQ(tiny.voxels(), 10u);
+}
+
 TEST(Vgicp, DegenerateInputGivesAStatusNeverNaN) {
   Prepared target(60000);
   target.From(Scene(10, Eigen::Isometry3d::Identity()), 0.1f);

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Room descriptors at the generator's extremes: the crop follows the ceiling each room measures
-// (2.3 m offices, 6 m halls), never a fixed height.
+// (2.3 m offices, 6 m halls), never a fixed height; and building one allocates nothing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "msgraphs/core/collab/room_descriptor.hpp"
 #include "msgraphs/core/slam/local_mapper.hpp"
 #include "synthetic_clouds.hpp"
@@ -15,10 +17,8 @@ namespace {
 
 constexpr double kSx = 10.0, kSy = 8.0;  // the room, corner at the world origin
 
-class DescriptorCeiling : public ::testing::TestWithParam<double> {};
-
-TEST_P(DescriptorCeiling, CropsBelowTheCeilingTheRoomMeasured) {
-  const double ceiling_m = GetParam();
+// The room seen by a mapper driven along its middle.
+void MapTheRoom(double ceiling_m, LocalMapper& mapper) {
   LocalMapperConfig config;
   config.max_scan_points = 25000;
   config.cloud_store_points = 32 * 6000;
@@ -26,7 +26,6 @@ TEST_P(DescriptorCeiling, CropsBelowTheCeilingTheRoomMeasured) {
   config.graph.max_factors = 32 * 64;
   config.grid.width = config.grid.height = 256;
   config.grid.origin_m = Eigen::Vector2f(-7.8f, -12.8f);  // the map frame starts at (2, 4)
-  LocalMapper mapper;
   const Status init = mapper.Init(config);
   ASSERT_TRUE(init) << init.error().detail;
   // Perfect odometry along the room's middle, a keyframe a metre; the map frame is the first
@@ -49,11 +48,23 @@ TEST_P(DescriptorCeiling, CropsBelowTheCeilingTheRoomMeasured) {
     ASSERT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
   }
   ASSERT_TRUE(mapper.Finish());
+}
 
+DistilledRoom TheRoom() {
   DistilledRoom room;
   room.centre = Eigen::Vector2d(kSx / 2 - 2.0, kSy / 2 - 4.0);  // in the map frame
   room.size_x_m = kSx;
   room.size_y_m = kSy;
+  return room;
+}
+
+class DescriptorCeiling : public ::testing::TestWithParam<double> {};
+
+TEST_P(DescriptorCeiling, CropsBelowTheCeilingTheRoomMeasured) {
+  const double ceiling_m = GetParam();
+  LocalMapper mapper;
+  ASSERT_NO_FATAL_FAILURE(MapTheRoom(ceiling_m, mapper));
+  const DistilledRoom room = TheRoom();
   RoomDescriptorBuilder builder;
   ASSERT_TRUE(builder.Init({}));
   BoundedVector<Eigen::Vector3f> cloud(builder.config().max_cloud_points);
@@ -72,6 +83,34 @@ TEST_P(DescriptorCeiling, CropsBelowTheCeilingTheRoomMeasured) {
 }
 
 INSTANTIATE_TEST_SUITE_P(GeneratorExtremes, DescriptorCeiling, ::testing::Values(2.3, 6.0));
+
+// room_descriptor.hpp: "Sized at Init; Build allocates nothing". The mapper, the builder (Init),
+// the cloud and the descriptor are set up first; the first Build and a second one are counted.
+TEST(RoomDescriptor, BuildAllocatesNothing) {
+  LocalMapper mapper;
+  ASSERT_NO_FATAL_FAILURE(MapTheRoom(2.3, mapper));
+  const DistilledRoom room = TheRoom();
+  RoomDescriptorBuilder builder;
+  ASSERT_TRUE(builder.Init({}));
+  BoundedVector<Eigen::Vector3f> cloud(builder.config().max_cloud_points);
+  ScanContext descriptor;
+
+  Status first, second;
+  std::uint64_t allocations = 0;
+  {
+    test::AllocationScope scope;
+    first = builder.Build(mapper, room, cloud, descriptor);
+    second = builder.Build(mapper, room, cloud, descriptor);
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  ASSERT_TRUE(first) << first.error().detail;
+  ASSERT_TRUE(second) << second.error().detail;
+  EXPECT_TRUE(builder.last_found_ceiling());
+  EXPECT_GE(cloud.size(), 100u);
+  EXPECT_LE(cloud.size(), builder.config().max_cloud_points);
+  EXPECT_GE(descriptor.points_used(), cloud.size() / 2);
+}
 
 }  // namespace
 }  // namespace msgraphs::core

@@ -72,6 +72,22 @@ TEST(KeyframeCloudStore, EvictsTheOldestAndTellsReusedKeysApart) {
   EXPECT_EQ(s.Put(9, 4, forty).error().code, Errc::kInvalidArgument);
 }
 
+TEST(KeyframeCloudStore, PuttingAndGettingAllocateNothingAfterInit) {
+  KeyframeCloudStore s;
+  s.Init(8, 1000);
+  const std::vector<Eigen::Vector3f> cloud(150, Eigen::Vector3f(1, 2, 3));
+  std::size_t found = 0;
+  test::AllocationScope scope;
+  // 200 keyframes through 8 keys and room for 6 clouds: keys reused, the oldest evicted.
+  for (std::uint32_t k = 0; k < 200; ++k) {
+    ASSERT_TRUE(s.Put(k % 8, k + 1, cloud));
+    found += s.Get(k % 8, k + 1).size();
+  }
+  EXPECT_EQ(scope.allocations(), 0u);
+  EXPECT_EQ(found, 200u * 150u);
+  EXPECT_GT(s.evicted(), 150u);
+}
+
 ExtractedPlane Wall(const Eigen::Vector3d& n, double d, double u_min, double u_max) {
   ExtractedPlane p;
   p.kind = std::fabs(n.z()) > 0.9 ? PlaneKind::kHorizontal : PlaneKind::kVertical;
@@ -529,6 +545,17 @@ TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {
   EXPECT_EQ(scope.allocations(), 0u);
   EXPECT_EQ(mapper.stats().no_odometry, 1u);
   EXPECT_EQ(mapper.stats().bad_scans, 1u);
+  EXPECT_EQ(mapper.stats().scan_points_beyond_capacity, 0u);
+  // A keyframe scan beyond max_scan_points: the excess is left out of the keyframe, counted.
+  ASSERT_GE(points.size(), 300u);
+  LocalMapperConfig small = config;
+  small.max_scan_points = points.size() - 100;
+  LocalMapper cut;
+  ASSERT_TRUE(cut.Init(small));
+  ASSERT_TRUE(cut.AddOdometry(0.5, Eigen::Isometry3d::Identity()));
+  ASSERT_TRUE(cut.AddOdometry(1.05, Eigen::Isometry3d::Identity()));
+  EXPECT_EQ(*cut.AddScan({points, times, 0.9, 1.0}), ScanOutcome::kKeyframe);
+  EXPECT_EQ(cut.stats().scan_points_beyond_capacity, 100u);
   LocalMapperConfig bad = config;
   bad.keyframe_spacing_m = -1;
   EXPECT_FALSE(LocalMapper().Init(bad));

@@ -6,11 +6,13 @@
 
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "msgraphs/drivers/pcap/pcap_reader.hpp"
 #include "msgraphs/drivers/pcap/pcap_writer.hpp"
 #include "velodyne_test_packets.hpp"
@@ -116,6 +118,99 @@ std::vector<std::uint8_t> UdpFrame(std::size_t payload_bytes, std::uint16_t port
   const std::size_t n = BuildUdpFrame(kSensor, {0x0A000001, port}, payload, frame).value();
   frame.resize(n);
   return frame;
+}
+
+// pcap_writer.hpp: "Buffered in one fixed buffer allocated at Create; writes never allocate".
+// The writer is created and the payloads made first; 500 records (about 600 kB, so the buffer
+// is flushed to the file on the way) are written inside the scope.
+TEST(PcapWriter, WritesNeverAllocate) {
+  const std::string path = TempPath("writes.pcap");
+  const UnixTime t0 = UnixTime::FromNanoseconds(1'700'000'000'000'000'000);
+  const std::vector<std::uint8_t> scan = Payload(1206, 1), position = Payload(512, 2);
+  const std::vector<std::uint8_t> frame = UdpFrame(100);
+  {
+    auto writer = PcapFileWriter::Create(path.c_str(), TimestampPrecision::kNanoseconds).value();
+    int failures = 0;
+    std::uint64_t allocations = 0;
+    {
+      test::AllocationScope scope;
+      for (int i = 0; i < 500; ++i) {
+        const UnixTime t = t0 + Duration::FromMicroseconds(1327 * i);
+        const Status s = i % 10 == 9 ? writer.WriteFrame(t, frame)
+                         : i % 2 == 0 ? writer.WriteUdp(t, kSensor, kBroadcast, scan)
+                                      : writer.WriteUdp(t, kSensor, kBroadcast, position);
+        if (!s) ++failures;
+      }
+      allocations = scope.allocations();
+    }
+    EXPECT_EQ(allocations, 0u);
+    EXPECT_EQ(failures, 0);
+    EXPECT_EQ(writer.records(), 500u);
+    ASSERT_TRUE(writer.Close());
+  }
+  auto reader = PcapFileReader::Open(path.c_str()).value();
+  PcapRecord record;
+  int records = 0;
+  while (reader.Next(record).value()) ++records;
+  EXPECT_EQ(records, 500);
+  std::remove(path.c_str());
+}
+
+// pcap_reader.hpp: "allocation-free per record", for both readers. The file is written, the
+// readers opened (the file reader's buffer is allocated at Open) and the expected payload sum
+// computed first; every record is read and parsed to its UDP payload inside the scope.
+TEST(PcapReader, ReadingRecordsAllocatesNothing) {
+  const std::string path = TempPath("reads.pcap");
+  const UnixTime t0 = UnixTime::FromNanoseconds(1'700'000'000'000'000'000);
+  std::uint64_t expected_sum = 0;
+  {
+    auto writer = PcapFileWriter::Create(path.c_str(), TimestampPrecision::kMicroseconds).value();
+    for (int i = 0; i < 500; ++i) {
+      const auto payload = Payload(i % 2 == 0 ? 1206 : 512, static_cast<std::uint8_t>(i));
+      for (const std::uint8_t b : payload) expected_sum += b;
+      ASSERT_TRUE(writer.WriteUdp(t0 + Duration::FromMicroseconds(1327 * i), kSensor, kBroadcast, payload));
+    }
+    ASSERT_TRUE(writer.Close());
+  }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(std::filesystem::file_size(path)));
+  ASSERT_GT(bytes.size(), kGlobalHeaderBytes);
+  FILE* f = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), f);
+  std::fclose(f);
+  ASSERT_EQ(got, bytes.size());
+  auto file_reader = PcapFileReader::Open(path.c_str()).value();
+  auto buffer_reader = PcapBufferReader::Open(bytes).value();
+  PcapRecord record;
+  PcapUdpCounters file_counters, buffer_counters;
+  std::uint64_t file_sum = 0, buffer_sum = 0;
+  bool file_clean_end = true, buffer_clean_end = true;
+
+  // Reads every record and sums its UDP payload; false when the reader stopped on an error.
+  auto drain = [&record](auto& reader, PcapUdpCounters& counters, std::uint64_t& sum) {
+    for (;;) {
+      const Expected<bool> next = reader.Next(record);
+      if (!next || !*next) return next.has_value();
+      if (auto d = ExtractUdp(reader.header(), record, counters)) {
+        for (const std::uint8_t b : d->payload) sum += b;
+      }
+    }
+  };
+  test::AllocationScope scope;
+  file_clean_end = drain(file_reader, file_counters, file_sum);
+  buffer_clean_end = drain(buffer_reader, buffer_counters, buffer_sum);
+  const std::uint64_t allocations = scope.allocations();
+
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_TRUE(file_clean_end);
+  EXPECT_TRUE(buffer_clean_end);
+  EXPECT_EQ(file_reader.records(), 500u);
+  EXPECT_EQ(buffer_reader.records(), 500u);
+  EXPECT_EQ(file_counters.udp_datagrams, 500u);
+  EXPECT_EQ(buffer_counters.udp_datagrams, 500u);
+  EXPECT_EQ(file_sum, expected_sum);
+  EXPECT_EQ(buffer_sum, expected_sum);
+  std::remove(path.c_str());
 }
 
 TEST(PcapReader, ReadsBigEndianFiles) {

@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <thread>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "msgraphs/runtime/pipeline/replay_clock.hpp"
 
 namespace msgraphs::runtime {
@@ -80,6 +82,52 @@ TEST(BoundedQueue, CloseWakesAWaitingProducer) {
   std::thread closer([&] { q.Close(); });
   EXPECT_EQ(q.BeginPush(Duration::FromSeconds(5)), nullptr);
   closer.join();
+}
+
+// bounded_queue.hpp: "nothing allocates after construction". The queue is constructed and each
+// slot's buffer sized once (the first fill); then 1000 cycles fill it, are refused (full: a
+// drop), and drain it in order, refilling the slots in place.
+TEST(BoundedQueue, NothingAllocatesAfterConstruction) {
+  constexpr std::size_t kSlots = 4;
+  constexpr int kCycles = 1000;
+  BoundedQueue<std::vector<int>> q(kSlots);
+  for (std::size_t i = 0; i < kSlots; ++i) {
+    std::vector<int>* slot = q.BeginPush(Duration());
+    ASSERT_NE(slot, nullptr);
+    slot->reserve(256);
+    q.CommitPush();
+  }
+  for (std::size_t i = 0; i < kSlots; ++i) q.Pop();
+
+  int refused = 0, out_of_order = 0, popped = 0, expected = 0, next = 0;
+  test::AllocationScope scope;
+  for (int cycle = 0; cycle < kCycles; ++cycle) {
+    for (std::size_t i = 0; i < kSlots; ++i) {
+      std::vector<int>* slot = q.BeginPush(Duration());
+      if (slot == nullptr) break;
+      slot->assign(100 + static_cast<std::size_t>(cycle % 100), next++);
+      q.CommitPush();
+    }
+    if (q.BeginPush(Duration()) == nullptr) ++refused;  // full: refused and counted
+    for (std::vector<int>* item = q.Front(Duration()); item != nullptr; item = q.Front(Duration())) {
+      if (item->empty() || item->front() != expected || item->size() != 100 + static_cast<std::size_t>(cycle % 100))
+        ++out_of_order;
+      ++expected;
+      ++popped;
+      q.Pop();
+    }
+  }
+  const std::uint64_t allocations = scope.allocations();
+
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(refused, kCycles);
+  EXPECT_EQ(out_of_order, 0);
+  EXPECT_EQ(popped, kCycles * static_cast<int>(kSlots));
+  const QueueStats s = q.stats();
+  EXPECT_EQ(s.dropped, static_cast<std::uint64_t>(kCycles));
+  EXPECT_EQ(s.pushed, kSlots + static_cast<std::uint64_t>(kCycles) * kSlots);
+  EXPECT_EQ(s.peak, kSlots);
+  EXPECT_EQ(s.size, 0u);
 }
 
 TEST(ReplayClock, KeepsTwoInputsInStepAtTheGivenSpeed) {

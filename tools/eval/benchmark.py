@@ -13,7 +13,7 @@ summaries (docs/collab-summary.md) and the simulator's shared-structure truth
 (truth/shared.csv): which views could merge at all.
 
     tools/eval/benchmark.py --build build/host-release --work out/benchmark [--missions 40]
-                            [--first 0] [--jobs 2] [--results docs/results.md]
+                            [--first 0] [--jobs 2] [--results docs/results.md] [--reuse-baseline]
     tools/eval/benchmark.py --build build/host-release --work out/bench-ci --ci   # 5 missions
 
 Writes WORK/benchmark.json (every mission's figures), WORK/benchmark.md (the tables) and,
@@ -108,8 +108,10 @@ def run(cmd, log):
         return rc, time.time() - started
 
 
-def run_mission(build, work, mission, options):
-    """Simulates (unless already there) and runs both algorithms; returns the mission's record."""
+def run_mission(build, work, mission, options, reuse_baseline=False):
+    """Simulates (unless already there) and runs both algorithms; returns the mission's record.
+    With reuse_baseline, a keyframe baseline summary already in the folder is read, not rerun
+    (the baseline does not use the merge rule: for measuring a change to the full algorithm)."""
     name = "m%03d-%s" % (mission["index"], mission["style"] or "any")
     folder = os.path.join(work, name)
     os.makedirs(folder, exist_ok=True)
@@ -129,6 +131,11 @@ def run_mission(build, work, mission, options):
     collab = os.path.join(build, "tools/msgraphs_collab")
     for variant, extra in (("full", []), ("keyframes", ["--mode", "keyframes"])):
         summary = os.path.join(folder, variant + ".json")
+        if variant == "keyframes" and reuse_baseline and os.path.exists(summary):
+            with open(summary) as f:
+                record[variant] = json.load(f)
+            record[variant + "_s"] = 0.0
+            continue
         cmd = [collab, "--run", recording, "--summary", summary, "--out", os.path.join(folder, variant)] + extra
         if variant == "full":
             cmd += ["--explain", os.path.join(folder, "explain")]
@@ -333,6 +340,8 @@ def main():
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--ci", action="store_true", help="5 short 2-robot missions (CI)")
     p.add_argument("--results", help="a markdown file whose benchmark section is replaced")
+    p.add_argument("--reuse-baseline", action="store_true",
+                   help="read the keyframe baseline's summaries already in WORK instead of rerunning it")
     a = p.parse_args()
     if a.ci:
         a.missions = 5
@@ -342,7 +351,7 @@ def main():
     missions = [plan(i, a.ci) for i in range(a.first, a.first + a.missions)]
     records = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = {pool.submit(run_mission, a.build, a.work, m, options): m for m in missions}
+        futures = {pool.submit(run_mission, a.build, a.work, m, options, a.reuse_baseline): m for m in missions}
         for future in concurrent.futures.as_completed(futures):
             r = future.result()
             records.append(r)

@@ -142,8 +142,10 @@ bool LocalMapper::Preprocess(const LidarScanView& scan,
   work_.clear();
   times_.clear();
   for (std::size_t i = 0; i < scan.points_lidar.size(); ++i) {
-    if (!work_.try_push_back(scan.points_lidar[i]))
-      break;  // beyond max_scan_points: counted by the caller's size
+    if (!work_.try_push_back(scan.points_lidar[i])) {
+      stats_.scan_points_beyond_capacity += scan.points_lidar.size() - i;
+      break;
+    }
     static_cast<void>(times_.try_push_back(scan.time_offset_s[i]));
   }
   // Deskew to the end of the sweep with the odometry's motion in the lidar frame.

@@ -14,6 +14,7 @@
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/realtime.hpp"
 #include "msgraphs/platform/udp_socket.hpp"
+#include "msgraphs/runtime/pipeline/sweep_copy.hpp"
 #include "node_impl.hpp"
 
 namespace msgraphs::runtime {
@@ -22,13 +23,9 @@ namespace {
 
 constexpr Duration kPollSlice = Duration::FromMilliseconds(50);
 
-void CopyScan(const drivers::velodyne::Scan& scan, ScanSlot& slot) {
-  slot.points.clear();
-  slot.time_offset_s.clear();
-  for (const auto& p : scan.points) {
-    slot.points.emplace_back(p.x_m, p.y_m, p.z_m);
-    slot.time_offset_s.push_back(static_cast<float>(static_cast<double>(p.time_offset_ns) * 1e-9));
-  }
+void CopyScan(const drivers::velodyne::Scan& scan, ScanSlot& slot, InputCounters& counters) {
+  const std::size_t cut = CopySweep(scan, slot.points, slot.time_offset_s);
+  if (cut > 0) counters.points_cut.fetch_add(cut, std::memory_order_relaxed);
   slot.start_s = scan.start_time.seconds_since_epoch();
   slot.end_s = scan.end_time.seconds_since_epoch();
   slot.sequence = scan.sequence;
@@ -81,7 +78,7 @@ void Node::Impl::LidarLoop() {
           platform::SleepUntil(std::min(due, platform::SteadyNow() + kPollSlice));
       }
       push([&](ScanSlot& slot) {
-        CopyScan(*scan, slot);
+        CopyScan(*scan, slot, lidar_counters);
         slot.last_packet = platform::SteadyNow();
       });
     }
@@ -121,7 +118,7 @@ void Node::Impl::LidarLoop() {
     }
     if (!*got || !source->scan().complete) continue;
     push([&](ScanSlot& slot) {
-      CopyScan(source->scan(), slot);
+      CopyScan(source->scan(), slot, lidar_counters);
       slot.last_packet = platform::SteadyNow();
     });
   }

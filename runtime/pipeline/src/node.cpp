@@ -8,6 +8,7 @@
 #include "msgraphs/drivers/gpio/gpio.hpp"
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/realtime.hpp"
+#include "msgraphs/runtime/pipeline/sweep_copy.hpp"
 #include "node_impl.hpp"
 
 namespace msgraphs::runtime {
@@ -87,8 +88,11 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
   // Every buffer is allocated here, before the threads start.
   for (std::size_t i = 0; i < config.scan_queue; ++i) {
     ScanSlot* slot = m.scans.BeginPush(Duration(), false);
-    slot->points.reserve(config.mapper.max_scan_points);
-    slot->time_offset_s.reserve(config.mapper.max_scan_points);
+    // Every point a sweep can carry, so the LiDAR thread's copy never grows a slot.
+    const std::size_t capacity =
+        SweepCapacity(drivers::velodyne::ScanAssemblerConfig{}, config.mapper.max_scan_points);
+    slot->points.reserve(capacity);
+    slot->time_offset_s.reserve(capacity);
     m.scans.CommitPush();
   }
   for (std::size_t i = 0; i < config.scan_queue; ++i) m.scans.Pop();
@@ -239,15 +243,20 @@ void Node::Impl::PrintStatus(double since_start_s) {
       peers += buffer;
     }
   }
+  // Points cut from sweeps are shown only when there are any (a sensor beyond the assembler's
+  // capacity), so the usual line stays as parsers know it.
+  char cut_text[40] = "";
+  if (const std::uint64_t cut = lidar_counters.points_cut.load(); cut > 0)
+    std::snprintf(cut_text, sizeof cut_text, ", %" PRIu64 " points cut", cut);
   std::printf(
       "[robot %u %7.1f s %-10s] lidar %.1f Hz (queue peak %zu/%zu, dropped %" PRIu64
-      ", bad %" PRIu64 ") | odometry %.0f Hz (peak %zu/%zu, dropped %" PRIu64 ", bad %" PRIu64
+      ", bad %" PRIu64 "%s) | odometry %.0f Hz (peak %zu/%zu, dropped %" PRIu64 ", bad %" PRIu64
       ") | map %" PRIu64
       " keyframes (p50 %.0f ms, p99 %.0f ms), %u walls, %u rooms, %zu priors | link sent %.1f kB, "
       "rejected %" PRIu64 ", malformed %" PRIu64 "; peers:%s\n",
       config.robot.value, since_start_s, link::ToString(state.load()),
       static_cast<double>(scans_now - last_scans) / dt, sq.peak, sq.capacity, sq.dropped,
-      lidar_counters.rejected.load(), static_cast<double>(odometry_now - last_odometry) / dt,
+      lidar_counters.rejected.load(), cut_text, static_cast<double>(odometry_now - last_odometry) / dt,
       oq.peak, oq.capacity, oq.dropped, odometry_counters.rejected.load(), s.keyframes,
       s.keyframe_p50_ms, s.keyframe_p99_ms, s.walls, s.rooms, s.plane_priors,
       static_cast<double>(sent) / 1e3, rejected, malformed,

@@ -60,6 +60,9 @@ class LatencyWindow {
 struct InputCounters {
   std::atomic<std::uint64_t> items{0};     ///< scans or odometry samples delivered
   std::atomic<std::uint64_t> rejected{0};  ///< malformed packets or frames
+  /// LiDAR points left out of a sweep: beyond its slot's reserved capacity, or dropped by a
+  /// full assembler (CopySweep). Never silently: the status line shows them.
+  std::atomic<std::uint64_t> points_cut{0};
   std::atomic<bool> done{false};           ///< the recording ended (never for live inputs)
   std::atomic<bool> failed{false};
   std::mutex error_mutex;

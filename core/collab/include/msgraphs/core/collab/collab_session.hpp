@@ -17,7 +17,8 @@
 //   merge or a merged map changed. A merge that later evidence contradicts is undone.
 //
 // Bounded: every store is sized at Init (capacities in CollabSessionConfig; the byte figure is
-// in stats()). Full stores refuse with a counter: a peer beyond max_peers is ignored, a room
+// in stats()); what allocates after Init is Ceres, in Publish's wall marginals (Distiller) and
+// in Match's fine alignments' solves and the collaborative graph's rebuild and solve. Full stores refuse with a counter: a peer beyond max_peers is ignored, a room
 // beyond max_rooms gets no descriptor, a room cloud beyond max_room_points is not described,
 // a peer's descriptor beyond max_peer_rooms is dropped, matches beyond max_matches_per_peer are
 // dropped, the peer cloud cache evicts its oldest entry. Not thread-safe: the caller serialises.

@@ -5,7 +5,10 @@
 //
 // Versioned and incremental: each wall and room carries the graph version in which it last
 // changed by more than the resend thresholds, so the codec can send only what changed since
-// what a peer acknowledged. Sized at Init; Update allocates nothing.
+// what a peer acknowledged. Its own stores are sized at Init. Update allocates: with
+// `marginal_covariances` (the default) it asks the S-Graph for the walls' marginals, which
+// ceres::Covariance computes with heap memory of its own (SGraph::PlaneMarginals); without
+// them, Update allocates nothing.
 #pragma once
 
 #include <cstdint>

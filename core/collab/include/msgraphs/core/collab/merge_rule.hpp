@@ -22,7 +22,8 @@
 //    rival too. So are the leader's slides along either principal direction of its agreement that
 //    stand (a structure repeated along it: racks at a pitch, a hall's bays).
 // 5. No refuted hypothesis may beat the leader by the margin, in agreement and in its weakest
-//    direction both (kContradicted): when the strongest evidence two maps have in common is
+//    direction both, nor by the margin in agreement net of its own conflict while no weaker in
+//    its weakest direction (kContradicted): when the strongest evidence two maps have in common is
 //    contradicted, the likeliest explanation is an error in the free space or the maps (the
 //    true transform refuted by an artefact), not that a much weaker alternative is true; and a
 //    weaker alternative is what a repeated structure (a mirrored wing) offers.

@@ -11,7 +11,9 @@
 //   which fixes roll and pitch when the matched rooms alone would not.
 // One global solve estimates every origin and refines every wall and room from all robots'
 // measurements. Ceres is private; every factor has a Huber kernel. Capacities are fixed at
-// Init; a full store refuses with kCapacityExceeded.
+// Init; a full store refuses with kCapacityExceeded. Not allocation-free: Clear() builds a new
+// ceres::Problem, and every solve allocates its factors and Ceres's own workspace (a solve
+// runs on the collaborative thread only when a merge or a merged map changed).
 #pragma once
 
 #include <Eigen/Geometry>

@@ -2,7 +2,8 @@
 // Downsampled keyframe clouds (base frame) for the local map and loop-closure verification, in
 // one ring of points sized at Init. When a new cloud does not fit, the oldest clouds are
 // evicted (counted): a loop closure to an evicted keyframe is then impossible, which the mapper
-// counts too. A cloud larger than the whole ring is refused. Nothing allocates after Init.
+// counts too. A cloud larger than the whole ring is refused. Nothing allocates after Init
+// (KeyframeCloudStore.PuttingAndGettingAllocateNothingAfterInit).
 #pragma once
 
 #include <Eigen/Core>

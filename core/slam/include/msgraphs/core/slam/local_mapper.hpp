@@ -15,8 +15,11 @@
 //
 // Core has no clock: an optional StageObserver, given by the caller, is told when each stage
 // ends, so tools measure per-stage times. Every buffer is sized at Init; the per-scan path
-// allocates nothing; per keyframe, only Ceres allocates (factor storage and solver workspace,
-// bounded by the graph's capacities).
+// allocates nothing (LocalMapper.BadScansAreCountedAndTheScanPathDoesNotAllocate). A keyframe
+// allocates: Ceres's factor storage and solver workspace (bounded by the graph's capacities).
+// The keyframe stages' own buffers do not: preprocessing (Perception.*AllocateNothing*), plane
+// extraction (Planes.ExtractionAllocatesNothingPerKeyframe), VGICP (Vgicp.RecoversAKnownTransform),
+// the cloud store, free space and rooms (Rooms.SegmentingAndDetectingAllocateNothing).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -173,6 +176,8 @@ struct LocalMapperStats {
   std::uint64_t odometry_gap_keyframes = 0;
   std::uint64_t odometry_slips = 0;  ///< steps whose odometry the slip gate weakened
   std::uint64_t bad_scans = 0;  ///< too few points, or mismatched spans
+  /// Points of keyframe scans beyond max_scan_points, left out of the keyframe (counted).
+  std::uint64_t scan_points_beyond_capacity = 0;
   std::uint64_t scan_match_accepted = 0;
   std::uint64_t scan_match_rejected_fitness = 0, scan_match_rejected_overlap = 0,
                 scan_match_rejected_diverged = 0, scan_match_rejected_failed = 0;

@@ -9,7 +9,8 @@
 // VGICP against the candidate's stored cloud, seeded with the current relative estimate; a
 // converged alignment with a low fitness and enough overlap becomes a loop-closure factor
 // whose information comes from the alignment's Hessian.
-// Sized at Init; Detect allocates nothing beyond Ceres' factor storage.
+// Sized at Init. Detect allocates: the accepted loop's factor and the solve after it are
+// Ceres's; its descriptor search and VGICP verification use buffers sized at Init.
 #pragma once
 
 #include <Eigen/Geometry>

@@ -11,7 +11,8 @@
 // - horizontal planes (floor and ceiling) are associated too, on the same rule;
 // - a plane seen from its back (the other face of a wall) never associates.
 // Wall extents (endpoints along the wall and heights) are kept here, in the map frame, for
-// room detection. Sized at Init; Associate allocates nothing.
+// room detection. Sized at Init; Associate's own work allocates nothing, but the observations
+// and planes it adds to the S-Graph allocate there (Ceres residual blocks).
 #pragma once
 
 #include <Eigen/Geometry>

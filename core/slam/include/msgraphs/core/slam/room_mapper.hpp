@@ -10,7 +10,8 @@
 //   both, or removed the corridor's vertices by hand);
 // - unmatched detections become new rooms; each joins the floor node.
 // The floor node is created with the first room, at the rooms' mean centre. Bounded: room and
-// pair stores sized at Init; Update allocates nothing beyond Ceres' own factor storage.
+// pair stores sized at Init; Update allocates in Ceres (the factors it adds); its segmentation
+// and detection do not (Rooms.SegmentingAndDetectingAllocateNothing).
 #pragma once
 
 #include <cstdint>

@@ -112,7 +112,8 @@ class FleetLink final : public core::CollabOutbox {
             std::span<const std::uint8_t> bytes) override;
 
   /// Waits up to `timeout` for the next collab message for this robot; true when `out` holds
-  /// one. `out.bytes` is reused (no allocation once it has grown to the largest message).
+  /// one. `out.bytes` is reused (it stops growing at the largest message); Fast DDS's own
+  /// reception allocates as Fast DDS does, which no test here counts.
   bool Receive(InboundMessage& out, Duration timeout);
 
   /// Publishes our telemetry (robot and stamp are filled in).
