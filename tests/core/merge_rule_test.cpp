@@ -233,6 +233,42 @@ TEST(MergeRule, ATruthRefutedByALittleStillBlocksAMuchWeakerLeader) {
   EXPECT_DOUBLE_EQ(d.best_refuted.agreement.agreement_m, 154.3);
 }
 
+// Rule 6: a robot whose map slipped saw room 1 twice, the second time 0.8 m east of the first
+// (an encoder slip its scan matching did not catch): the copy's walls stand in the room's and
+// its neighbour's free space. Its decisions about a peer with which it shares room 3 would merge
+// (MergeRule.APairSharingOneRoomMerges); with a map that contradicts its own free space, neither
+// robot merges the other, and the rule says why.
+TEST(MergeRule, AMapThatContradictsItsOwnFreeSpaceMergesNothing) {
+  const PlanBuilding building = VariedRooms();
+  const Eigen::Isometry2d Ta = Pose2(3, -7, 2.9);
+  Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Ta);
+  Robot b(building, {{0, 9, 30}, {3}, {4}, {5}}, Pose2(-25, 4, -0.4));
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  const MergeRuleConfig config;
+  Hypothesis self;
+  EXPECT_TRUE(SelfConsistent(a.walls, a.free, search, config, self));
+  EXPECT_LT(self.conflict_m(), config.refute_conflict_m) << "a consistent map stands on itself";
+  ASSERT_EQ(Decide(a, b, search).verdict, MergeVerdict::kMerge);
+
+  const DistilledGraph copy = building.Walls({{1}}, Ta * Pose2(0.8, 0, 0));
+  for (DistilledWall w : copy.walls.span()) {
+    w.id += 100;
+    ASSERT_TRUE(a.graph.walls.try_push_back(w));
+  }
+  a.walls.Build(a.graph.walls.span(), 0.5);
+  a.self.Search(a.walls, {}, a.walls, {}, {}, true);
+  EXPECT_FALSE(SelfConsistent(a.walls, a.free, search, config, self));
+  EXPECT_GT(self.conflict_m(), config.UndoLimit(self));
+  const MergeDecision d = Decide(a, b, search);
+  EXPECT_EQ(d.verdict, MergeVerdict::kSelfContradicted) << ToString(d.verdict);
+  EXPECT_GT(d.self_conflict_a_m, config.UndoLimit(self));
+  EXPECT_LT(d.self_conflict_b_m, config.refute_conflict_m);
+  const MergeDecision back = Decide(b, a, search);
+  EXPECT_EQ(back.verdict, MergeVerdict::kSelfContradicted) << ToString(back.verdict);
+  EXPECT_GT(back.self_conflict_b_m, config.UndoLimit(self));
+}
+
 TEST(MergeRule, DecidingAllocatesNothing) {
   const PlanBuilding building = VariedRooms();
   Robot a(building, {{0, 0, 14}, {1}, {2}, {3}}, Pose2(3, -7, 2.9));

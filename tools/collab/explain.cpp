@@ -115,6 +115,7 @@ const char* Cause(const ViewEvaluation& v, const ViewExplanation& e, const core:
   if (e.truth.conflict_m() > rule.AcceptLimit(e.truth)) return "truth conflicted";
   if (e.decision.verdict == core::MergeVerdict::kAmbiguous) return "ambiguous";
   if (e.decision.verdict == core::MergeVerdict::kTruncated) return "search truncated";
+  if (e.decision.verdict == core::MergeVerdict::kSelfContradicted) return "a map contradicts itself";
   return "undecided at the end";
 }
 

@@ -10,6 +10,8 @@
 // - "too little shared": the truth's agreement is below the rule's minimum (the robots did not
 //   see enough of the same walls);
 // - "ambiguous": the truth stands but a rival within the margin stands too;
+// - "a map contradicts itself": the rule would merge, but one robot's walls stand in its own
+//   free space (merge rule 6);
 // - "merged wrongly" / "merged, then undone" and so on from the final decision.
 // --explain DIR also draws each summary with the other robot's walls laid in by the truth (PPM:
 // unknown grey, free white, occupied black, the other's walls orange, red where they conflict,

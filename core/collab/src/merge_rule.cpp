@@ -35,6 +35,8 @@ const char* ToString(MergeVerdict v) {
       return "search truncated (a bounded store was full)";
     case MergeVerdict::kContradicted:
       return "the strongest hypothesis is refuted by free space";
+    case MergeVerdict::kSelfContradicted:
+      return "a map contradicts its own free space";
     case MergeVerdict::kUnconfirmed:
       return "the leader awaits confirmation by a decision on new evidence";
     case MergeVerdict::kMerge:
@@ -58,6 +60,18 @@ void MeasureConflict(Hypothesis& h, const MergeInputs& in, const FreeSpaceConfli
   h.conflict_b_in_a = ConflictOf(*in.walls_b, *in.free_b, h.T_a_b, *in.walls_a, *in.free_a, c);
   h.conflict_a_in_b = ConflictOf(*in.walls_a, *in.free_a, h.T_a_b.inverse(), *in.walls_b, *in.free_b, c);
   h.conflict_known = true;
+}
+
+bool SelfConsistent(const WallIndex& walls, const FreeSpaceSummary& free, const AlignmentSearch& search,
+                    const MergeRuleConfig& c, Hypothesis& h) {
+  const PlanarTransform identity{};
+  h = search.Evaluate(walls, walls, identity);
+  // Laid on itself, a map's walls meet its own free space in one direction only (the walls of
+  // one map in the free space of the same map): conflict_b_in_a carries it all.
+  h.conflict_b_in_a = ConflictOf(walls, free, identity, walls, free, c.conflict);
+  h.conflict_a_in_b = FreeSpaceConflict{};
+  h.conflict_known = true;
+  return StillStanding(h, c);
 }
 
 MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const MergeRuleConfig& c,
@@ -241,6 +255,19 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     // A merge is undone when a rival now beats it by the margin, not merely when one stands.
     out.overturned = keeping && Beats(out.rival, L, c.margin_ratio, c);
     return out;
+  }
+  // Rule 6: a new merge (or a move to another transform) needs both maps consistent with their
+  // own free space; measured only here, where the rule would merge, as it is rarely needed.
+  if (!keeping) {
+    Hypothesis self_a, self_b;
+    const bool consistent_a = SelfConsistent(*in.walls_a, *in.free_a, search, c, self_a);
+    const bool consistent_b = SelfConsistent(*in.walls_b, *in.free_b, search, c, self_b);
+    out.self_conflict_a_m = self_a.conflict_m();
+    out.self_conflict_b_m = self_b.conflict_m();
+    if (!consistent_a || !consistent_b) {
+      out.verdict = MergeVerdict::kSelfContradicted;
+      return out;
+    }
   }
   out.verdict = MergeVerdict::kMerge;
   return out;

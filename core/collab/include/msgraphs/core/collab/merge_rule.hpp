@@ -27,7 +27,15 @@
 //    contradicted, the likeliest explanation is an error in the free space or the maps (the
 //    true transform refuted by an artefact), not that a much weaker alternative is true; and a
 //    weaker alternative is what a repeated structure (a mirrored wing) offers.
-// 6. Then: merge with the leader, once it has led `confirmations` consecutive decisions, each
+// 6. Neither map may contradict its own free space: its walls, laid on themselves by the
+//    identity (the one transform known to be true), must stand under the undo limit
+//    (kSelfContradicted). A robot whose map slipped (an encoder slip its scan matching did not
+//    catch) has walls where it saw through; its negative evidence then refutes the truth and
+//    lets aliases stand, so no new merge is made on it (benchmark m023: robot 1's map, 20 cm
+//    off, 5-8 m of its walls in its own free space from 70 s on, merged robot 2 half turned at
+//    90 s; every other map of that mission: at most 1.1 m). A merge already made is judged as
+//    before.
+// 7. Then: merge with the leader, once it has led `confirmations` consecutive decisions, each
 //    confirming one on a newer graph with more wall on wall in its weakest direction.
 // A merged pair is kept while its hypothesis has at most `undo_conflict_m` of conflict and no
 // rival beats it by the margin (hysteresis: accept at accept_conflict_m, refute others beyond
@@ -113,6 +121,8 @@ enum class MergeVerdict : std::uint8_t {
   /// The strongest evidence (a hypothesis beating the leader by the margin) is refuted: either
   /// the free space is in error or the maps disagree; a weaker alternative is not trusted.
   kContradicted,
+  /// The rule would merge, but one of the two maps contradicts its own free space (rule 6).
+  kSelfContradicted,
   /// The rule would merge, but this leader has not yet led `confirmations` consecutive
   /// decisions (the session's bookkeeping, collab_merge.cpp).
   kUnconfirmed,
@@ -132,6 +142,8 @@ struct MergeDecision {
   bool keeping = false;     ///< the leader is the current merge (hysteresis applied)
   bool overturned = false;  ///< kAmbiguous while merged, and the rival beats the current merge
   std::size_t hypotheses = 0, refuted = 0;
+  /// Rule 6, measured when the rule would merge anew: each map's walls in its own free space (m).
+  double self_conflict_a_m = 0, self_conflict_b_m = 0;
 };
 
 /// Everything the rule looks at for one robot pair. `sym_a`, `sym_b`: the maps' own symmetries
@@ -150,6 +162,12 @@ struct MergeInputs {
 /// the pair is merged with now, which keeps the merge under the hysteresis rule.
 MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const MergeRuleConfig& config,
                           const PlanarTransform* current);
+
+/// A map against itself (rule 6): its walls and openings laid on its own free space by the
+/// identity; `h` gets the identity's agreement and conflict. True when it stands under the undo
+/// limit (the most lenient: a map is consistent unless it would undo a merge with itself).
+bool SelfConsistent(const WallIndex& walls, const FreeSpaceSummary& free, const AlignmentSearch& search,
+                    const MergeRuleConfig& config, Hypothesis& h);
 
 /// Fills h's conflicts (both directions).
 void MeasureConflict(Hypothesis& h, const MergeInputs& in, const FreeSpaceConflictConfig& config);
