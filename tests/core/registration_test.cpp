@@ -140,6 +140,66 @@ TEST(GaussianVoxelMap, BuildAllocatesNothing) {
   EXPECT_EQ(tiny.voxels(), 10u);
 }
 
+// A corridor without ends: its walls, floor and ceiling fix everything but the position along
+// it. A prior (the encoders' step) holds that direction; where the clouds constrain (across
+// the corridor) they win over a prior 5 cm off, as a slip would put it: it pulls them by what
+// its weight against the clouds' calibrated 2 cm says (about a quarter of its offset here),
+// not to itself. The reported Hessian is the clouds' alone.
+std::vector<Eigen::Vector3f> EndlessCorridor(std::uint32_t seed, const Eigen::Isometry3d& T) {
+  const Eigen::Isometry3d T_inv = T.inverse();
+  std::vector<Eigen::Vector3f> out;
+  for (const Eigen::Vector3f& p : test::BoxRoom(40, 2.4, 3, 30000, 0.01, seed, T)) {
+    const double x = (T_inv * p.cast<double>()).x();  // drop the two end walls
+    if (x > 0.05 && x < 39.95) out.push_back(p);
+  }
+  return out;
+}
+
+TEST(Vgicp, APriorHoldsWhatTheCloudsLeaveFreeAndNothingElse) {
+  const Eigen::Isometry3d origin(Eigen::Translation3d(-20, -1.2, -1.0));
+  const Eigen::Isometry3d truth(Eigen::Translation3d(0.5, 0.03, 0.0));
+  Prepared target(40000), source(40000);
+  target.From(EndlessCorridor(3, origin), 0.1f);
+  source.From(EndlessCorridor(4, truth.inverse() * origin), 0.1f);
+  GaussianVoxelMap map;
+  map.Init(40000);
+  ASSERT_TRUE(map.Build(target.points.span(), target.covs.span(), 0.4));
+  Vgicp vgicp;
+  vgicp.Init(40000);
+  // Seeded 0.2 m along the corridor: the clouds alone leave it there.
+  const Eigen::Isometry3d seed = Eigen::Translation3d(0.2, 0, 0) * truth;
+  auto free = vgicp.Align(source.points.span(), source.covs.span(), map, target.points.span(),
+                          target.tree, seed, {});
+  ASSERT_TRUE(free.has_value()) << free.error().detail;
+  EXPECT_GT(std::fabs(free->T_target_source.translation().x() - truth.translation().x()), 0.1);
+  // The prior: along the corridor at the truth, across it 5 cm off.
+  VgicpPrior prior;
+  prior.T_target_source = Eigen::Translation3d(0, 0.05, 0) * truth;
+  prior.information.diagonal() << Eigen::Vector3d::Constant(1 / (0.05 * 0.05)),
+      Eigen::Vector3d::Constant(1 / (0.01 * 0.01));
+  prior.clouds_sigma_m = 0.02;
+  auto held = vgicp.Align(source.points.span(), source.covs.span(), map, target.points.span(),
+                          target.tree, seed, {}, nullptr, &prior);
+  ASSERT_TRUE(held.has_value()) << held.error().detail;
+  EXPECT_TRUE(held->converged);
+  EXPECT_NEAR(held->T_target_source.translation().x(), truth.translation().x(), 0.01);
+  EXPECT_NEAR(held->T_target_source.translation().y(), truth.translation().y(), 0.02);
+  // The Hessian is the clouds': as weak along the corridor as without the prior.
+  const Eigen::Matrix3d held_tt = held->hessian.topLeftCorner<3, 3>();
+  const Eigen::Matrix3d free_tt = free->hessian.topLeftCorner<3, 3>();
+  EXPECT_NEAR(held_tt(0, 0), free_tt(0, 0), 1e-3 * held_tt.norm());
+  // A prior that is not a rigid transform is refused.
+  VgicpPrior bad = prior;
+  bad.T_target_source.linear()(0, 0) = 2;
+  EXPECT_FALSE(vgicp.Align(source.points.span(), source.covs.span(), map, target.points.span(),
+                           target.tree, seed, {}, nullptr, &bad));
+  test::AllocationScope scope;
+  auto again = vgicp.Align(source.points.span(), source.covs.span(), map, target.points.span(),
+                           target.tree, seed, {}, nullptr, &prior);
+  EXPECT_EQ(scope.allocations(), 0u);
+  EXPECT_TRUE(again.has_value());
+}
+
 TEST(Vgicp, DegenerateInputGivesAStatusNeverNaN) {
   Prepared target(60000);
   target.From(Scene(10, Eigen::Isometry3d::Identity()), 0.1f);

@@ -5,6 +5,7 @@
 // bad input counted; no allocation on the per-scan path.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -176,6 +177,29 @@ TEST(PlaneMapper, AssociatesBySideAndExtentNotJustByLine) {
   EXPECT_NEAR(std::max(walls[0].a.y(), walls[0].b.y()), 2.0, 1e-6);  // the union of both sightings
 }
 
+// The floor applies where the wall was seen: a patch 4 m along the wall from the keyframe keeps
+// a precise offset there, and its offset at the keyframe carries the angle's floor times 4 m.
+TEST(PlaneMapper, TheCovarianceFloorAppliesWhereTheWallWasSeen) {
+  const double floor_m = 0.01;
+  ExtractedPlane near = Wall(Eigen::Vector3d(-1, 0, 0), 2.0, -0.5, 0.5);  // centroid at the foot point
+  ExtractedPlane far = Wall(Eigen::Vector3d(-1, 0, 0), 2.0, 3.5, 4.5);    // 4 m along the wall
+  near.covariance = far.covariance = Eigen::Vector3d(1e-8, 1e-8, 1e-8).asDiagonal();
+  const Eigen::Matrix3d c_near = PlaneObservationCovariance(near, floor_m);
+  EXPECT_NEAR(c_near(2, 2), floor_m * floor_m, 1e-6);
+  EXPECT_NEAR(c_near(0, 0), floor_m * floor_m, 1e-6);
+  const Eigen::Matrix3d c_far = PlaneObservationCovariance(far, floor_m);
+  const double lever = far.basis_u.dot(far.centroid);
+  ASSERT_NEAR(std::fabs(lever), 4.0, 1e-9);
+  // At the origin: the floor plus the angle's floor over the lever.
+  EXPECT_NEAR(c_far(2, 2), floor_m * floor_m * (1 + lever * lever), 1e-6);
+  // At the centroid (d + alpha * lever): just the floor.
+  const Eigen::Vector3d at_centroid(lever, 0, 1);
+  EXPECT_NEAR(at_centroid.dot(c_far * at_centroid), floor_m * floor_m, 1e-6);
+  // A fit less precise than the floor keeps its own figures.
+  far.covariance = Eigen::Vector3d(1e-2, 1e-2, 1e-2).asDiagonal();
+  EXPECT_TRUE(PlaneObservationCovariance(far, floor_m).isApprox(far.covariance, 1e-9));
+}
+
 TEST(LoopCloser, InformationKeepsTheHessiansShape) {
   Matrix6d H = Matrix6d::Identity();
   H.diagonal() << 400, 400, 4, 1000, 1000, 1000;  // weak along z: a corridor-like degeneracy
@@ -304,6 +328,7 @@ TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
 double WorstAfterASlip(double motion_seed_max_age_s, LocalMapperStats& stats) {
   LocalMapperConfig config = SmallConfig(64, 256);
   config.motion_seed_max_age_s = motion_seed_max_age_s;
+  config.track_scans = false;  // keyframes only: the pace seed is their slip remedy
   LocalMapper mapper;
   EXPECT_TRUE(mapper.Init(config));
   // Short and sparse: the test runs under qemu-aarch64 too.
@@ -393,6 +418,58 @@ TEST(LocalMapper, AFootSlipIsMatchedFromTheLastMatchsPace) {
   EXPECT_GE(refused(without), 1u);
   EXPECT_EQ(with.scan_match_accepted, without.scan_match_accepted + refused(without) - refused(with));
   EXPECT_LT(refused(with), refused(without));
+}
+
+// Sweeps at 10 Hz while the robot walks 6 m across the room at 1 m/s, its encoders reporting
+// 45 % of the motion for one second (a foot slipping): 0.55 m short by the next keyframe, far
+// beyond max_correction_m. Scan tracking registers every sweep, each only 5.5 cm off, and the
+// map stays on the truth; keyframes alone (the pace seed off too) end decimetres off.
+double WorstAfterASlipAt10Hz(bool track_scans, LocalMapperStats& stats) {
+  LocalMapperConfig config = SmallConfig(32, 256);
+  config.track_scans = track_scans;
+  config.motion_seed_max_age_s = 0;
+  LocalMapper mapper;
+  EXPECT_TRUE(mapper.Init(config));
+  auto truth_at = [](double t) {
+    Eigen::Isometry3d T = Pose(2.0 + std::clamp(t, 0.0, 6.0), 4.0 + 0.3 * std::sin(0.5 * t), 0.1);
+    T.translation().z() = 0.5;
+    return T;
+  };
+  auto reported = [](double t) { return t < 2.0 ? t : t < 3.0 ? 2.0 + 0.45 * (t - 2.0) : t - 0.55; };
+  constexpr std::size_t kPoints = 6000;
+  std::vector<float> times(kPoints, 0.1f);
+  double next_odometry = 0.0;
+  double worst = 0;
+  for (int k = 1; k <= 60; ++k) {
+    const double t = 0.1 * k;
+    for (; next_odometry <= t + 0.05; next_odometry += 0.02) {
+      // The encoders integrate the reported motion; the heading and the sway are right.
+      Eigen::Isometry3d T_odom = truth_at(reported(next_odometry));
+      T_odom.linear() = truth_at(next_odometry).linear();
+      T_odom.translation().y() = truth_at(next_odometry).translation().y();
+      EXPECT_TRUE(mapper.AddOdometry(next_odometry, truth_at(0).inverse() * T_odom));
+    }
+    const auto points = ScanAt(truth_at(t), config, static_cast<std::uint32_t>(k), kPoints);
+    EXPECT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
+  }
+  EXPECT_TRUE(mapper.Finish());
+  const SGraph& g = mapper.graph();
+  for (std::uint32_t k = 0; k < g.keyframe_slots(); ++k) {
+    const Eigen::Isometry3d truth = truth_at(0).inverse() * truth_at(g.keyframe_stamp(k));
+    worst = std::max(worst, (g.keyframe_pose(k).translation() - truth.translation()).norm());
+  }
+  stats = mapper.stats();
+  return worst;
+}
+
+TEST(LocalMapper, AFootSlipBetweenKeyframesIsTrackedSweepBySweep) {
+  LocalMapperStats tracked{}, keyframes_only{};
+  EXPECT_LT(WorstAfterASlipAt10Hz(true, tracked), 0.05);
+  EXPECT_GT(WorstAfterASlipAt10Hz(false, keyframes_only), 0.15);
+  EXPECT_GT(tracked.scans_tracked, 50u);
+  EXPECT_EQ(keyframes_only.scans_tracked, 0u);
+  // The slip gate saw the encoders disagree with the matches it was given.
+  EXPECT_GE(tracked.odometry_slips, 1u);
 }
 
 class Relocalisation : public ::testing::TestWithParam<double> {};
@@ -543,6 +620,7 @@ TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {
     EXPECT_EQ(*outcome, ScanOutcome::kNotKeyframe);
   }
   EXPECT_EQ(scope.allocations(), 0u);
+  EXPECT_EQ(mapper.stats().scans_tracked, 50u);  // each of them registered (scan tracking)
   EXPECT_EQ(mapper.stats().no_odometry, 1u);
   EXPECT_EQ(mapper.stats().bad_scans, 1u);
   EXPECT_EQ(mapper.stats().scan_points_beyond_capacity, 0u);

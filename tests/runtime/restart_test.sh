@@ -19,7 +19,7 @@ source = candump
 candump = run/robot1/odometry.log
 [replay]
 pace = recorded
-speed = 4
+speed = 2
 [link]
 domain = $domain
 loopback_only = true
@@ -35,10 +35,10 @@ start() {
 }
 start 1; pid1=$!
 start 2; pid2=$!
-# Kill robot 1 once it has mapped a good part of its mission (30 s at 4x: about 60 keyframes).
+# Kill robot 1 once it has mapped a quarter of its mission (30 keyframes of about 120).
 for _ in $(seq 1 300); do
   kf=$(grep -o "map [0-9]* keyframes" "$work/robot1.log" | tail -1 | grep -o "[0-9]*")
-  [[ -n "$kf" && $kf -ge 50 ]] && break
+  [[ -n "$kf" && $kf -ge 30 ]] && break
   sleep 0.1
 done
 kill -9 $pid1

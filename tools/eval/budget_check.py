@@ -58,7 +58,7 @@ def parse_slam(text):
     stages = {}
     in_table = False
     for line in text.splitlines():
-        if line.startswith("per keyframe [ms]"):
+        if line.startswith("per keyframe [ms]") or line.startswith("per sweep between keyframes"):
             in_table = True
             continue
         if in_table:

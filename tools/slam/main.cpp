@@ -10,9 +10,12 @@
 // --matches FILE writes every keyframe's scan match (CSV: the two stamps, the result, the fitness,
 // the fitness gate's limit, the transform) for tools/eval/match_errors.py to judge against the
 // truth; --fitness-floor and --fitness-outlier-z set the gate as the node's [mapping] keys do.
+// --odometry-from-truth feeds the ground truth (at 50 Hz, interpolated) as the encoders: what is
+// left of the ATE is the front end's and the graph's own (docs/s-graph.md, "Plane covariance").
 //
 //   msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] [--max-keyframes N]
 //                 [--matches FILE] [--fitness-floor M2] [--fitness-outlier-z Z]
+//                 [--odometry-from-truth]
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -76,12 +79,17 @@ class Timer final : public core::StageObserver {
     }
     std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "total", Percentile(total_, 0.5),
                 Percentile(total_, 0.9), Percentile(total_, 0.99), Percentile(total_, 1.0));
+    std::printf("per sweep between keyframes [ms] (scan tracking), %zu sweeps\n", sweeps_.size());
+    std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "sweep", Percentile(sweeps_, 0.5),
+                Percentile(sweeps_, 0.9), Percentile(sweeps_, 0.99), Percentile(sweeps_, 1.0));
   }
+  /// A sweep that was not a keyframe took this long in AddScan.
+  void Sweep(double ms) { sweeps_.push_back(ms); }
   const std::vector<double>& total() const { return total_; }
 
  private:
   std::array<std::vector<double>, static_cast<std::size_t>(core::MapperStage::kCount)> stages_;
-  std::vector<double> total_;
+  std::vector<double> total_, sweeps_;
   Clock::time_point start_, last_;
   bool active_ = false;
 };
@@ -118,7 +126,7 @@ void PrintAte(std::size_t keyframes,
 int main(int argc, char** argv) {
   std::string run, out_dir;
   int robot = 1;
-  bool markdown = false, verbose = false;
+  bool markdown = false, verbose = false, odometry_from_truth = false;
   std::size_t max_keyframes = 0;
   std::string matches_path;
   double fitness_floor_m2 = -1, fitness_outlier_z = -1;
@@ -138,6 +146,8 @@ int main(int argc, char** argv) {
       fitness_floor_m2 = std::atof(argv[++i]);
     else if (a == "--fitness-outlier-z" && i + 1 < argc)
       fitness_outlier_z = std::atof(argv[++i]);
+    else if (a == "--odometry-from-truth")
+      odometry_from_truth = true;
     else if (a == "--markdown")
       markdown = true;
     else if (a == "--verbose")
@@ -146,7 +156,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] "
                    "[--max-keyframes N] [--matches FILE] [--fitness-floor M2] "
-                   "[--fitness-outlier-z Z]\n");
+                   "[--fitness-outlier-z Z] [--odometry-from-truth]\n");
       return 2;
     }
   }
@@ -159,6 +169,19 @@ int main(int argc, char** argv) {
   if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;
   if (fitness_floor_m2 >= 0) config.scan_match_max_fitness_m2 = fitness_floor_m2;
   if (fitness_outlier_z >= 0) config.scan_match_fitness_outlier_z = fitness_outlier_z;
+  std::vector<tools::StampedPose> truth_as_odometry;
+  if (odometry_from_truth) {
+    const tools::TruthTrajectory truth(tools::ReadTum((dir / "ground_truth.tum").string()));
+    if (truth.samples().size() < 2) {
+      std::fprintf(stderr, "slam: --odometry-from-truth needs %s\n", (dir / "ground_truth.tum").c_str());
+      return 2;
+    }
+    const Eigen::Isometry3d T_start_world = truth.samples().front().T.inverse();
+    for (double t = truth.samples().front().t; t <= truth.samples().back().t; t += 0.02) {
+      if (const auto at = truth.At(t); at.ok) truth_as_odometry.push_back({t, T_start_world * at.T});
+    }
+    config.odometry_capacity = std::max(config.odometry_capacity, truth_as_odometry.size() + 16);
+  }
   std::FILE* matches = nullptr;
   if (!matches_path.empty()) {
     matches = std::fopen(matches_path.c_str(), "w");
@@ -204,6 +227,10 @@ int main(int argc, char** argv) {
       static_cast<void>(mapper.AddOdometry(p.stamp.seconds_since_epoch(), T));
     }
   };
+  if (odometry_from_truth) {
+    odometry_done = true;  // the encoders are not read
+    for (const tools::StampedPose& p : truth_as_odometry) static_cast<void>(mapper.AddOdometry(p.t, p.T));
+  }
   std::vector<Eigen::Vector3f> points;
   std::vector<float> times;
   Timer timer;
@@ -223,7 +250,10 @@ int main(int argc, char** argv) {
     feed_odometry_until(view.end_s + 0.05);
     const auto loops_before = mapper.loop_closer().stats().accepted;
     const auto rejected_before = mapper.loop_closer().stats().rejected_after_solve;
+    const auto sweep_start = Clock::now();
     const auto outcome = mapper.AddScan(view, &timer);
+    if (outcome && *outcome == core::ScanOutcome::kNotKeyframe)
+      timer.Sweep(std::chrono::duration<double, std::milli>(Clock::now() - sweep_start).count());
     const core::ScanMatchRecord& m = mapper.last_scan_match();
     if (matches != nullptr && outcome && *outcome == core::ScanOutcome::kKeyframe && m.attempted) {
       const Eigen::Quaterniond q(m.T_from_to.linear());

@@ -2,6 +2,7 @@
 #include "msgraphs/core/registration/vgicp.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "msgraphs/core/geometry/se3.hpp"
@@ -112,7 +113,8 @@ Expected<VgicpResult> Vgicp::Align(std::span<const Eigen::Vector3f> source_point
                                    std::span<const Eigen::Matrix3f> source_covariances,
                                    const GaussianVoxelMap& target_map, std::span<const Eigen::Vector3f> target_points,
                                    const KdTree& target_tree, const Eigen::Isometry3d& initial_guess,
-                                   const VgicpConfig& config, const ParallelExecutor* executor) {
+                                   const VgicpConfig& config, const ParallelExecutor* executor,
+                                   const VgicpPrior* prior) {
   if (Status s = config.Validate(); !s) return s.error();
   if (chunks_.empty()) return Error{Errc::kInvalidArgument, "vgicp: Init was not called"};
   if (source_points.size() != source_covariances.size()) return Error{Errc::kInvalidArgument, "vgicp: one covariance per source point"};
@@ -148,16 +150,48 @@ Expected<VgicpResult> Vgicp::Align(std::span<const Eigen::Vector3f> source_point
     }
     return sum;
   };
+  if (prior != nullptr && (!IsValidRigidTransform(prior->T_target_source, 1e-4) || !prior->information.allFinite())) {
+    return Error{Errc::kInvalidArgument, "vgicp: the prior is not a rigid transform or its information is not finite"};
+  }
+  // The prior's residual e = Log(T_prior^-1 T); for T * Exp(delta), de/d(delta) is about the
+  // identity near the prior (its right Jacobian), which is where a prior is any use.
+  Eigen::Isometry3d T_prior_inv = Eigen::Isometry3d::Identity();
+  if (prior != nullptr) T_prior_inv = prior->T_target_source.inverse();
+  Eigen::Matrix<double, 6, 6> prior_information = Eigen::Matrix<double, 6, 6>::Zero();
+  auto add_prior = [&](const Eigen::Isometry3d& T, Accumulator& acc, bool jacobians) {
+    if (prior == nullptr) return;
+    const Vector6d e = Se3Log(T_prior_inv * T);
+    acc.cost += e.dot(prior_information * e);
+    if (jacobians) {
+      acc.H += prior_information;
+      acc.b += prior_information * e;
+    }
+  };
+  Eigen::Matrix<double, 6, 6> clouds_hessian = Eigen::Matrix<double, 6, 6>::Zero();
   auto evaluate = [&](const Eigen::Isometry3d& T, bool jacobians) {
     job.T = T;
     job.with_jacobians = jacobians;
-    return run(&Vgicp::LinearizeChunk);
+    Accumulator acc = run(&Vgicp::LinearizeChunk);
+    if (jacobians) clouds_hessian = acc.H;
+    add_prior(T, acc, jacobians);
+    return acc;
   };
 
   VgicpResult result;
   Eigen::Isometry3d T = initial_guess;
   Accumulator lin = evaluate(T, true);
   if (lin.count < 10) return Error{Errc::kDegenerate, "vgicp: fewer than 10 correspondences at the initial guess"};
+  if (prior != nullptr) {
+    prior_information = prior->information;
+    if (prior->clouds_sigma_m > 0) {
+      // Metric information -> Hessian units: the Hessian H counts as H / (sigma^2 lambda_max).
+      const Eigen::Matrix3d Htt = 0.5 * (clouds_hessian.topLeftCorner<3, 3>() +
+                                         clouds_hessian.topLeftCorner<3, 3>().transpose());
+      const double strongest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Htt).eigenvalues().maxCoeff();
+      prior_information *= strongest > 0 ? prior->clouds_sigma_m * prior->clouds_sigma_m * strongest : 0.0;
+    }
+    lin = evaluate(T, true);  // now with the prior
+  }
   double lambda = config.initial_lambda_factor * lin.H.diagonal().maxCoeff();
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     result.iterations = iteration + 1;
@@ -197,7 +231,7 @@ Expected<VgicpResult> Vgicp::Align(std::span<const Eigen::Vector3f> source_point
   result.T_target_source = T;
   result.final_cost = lin.cost;
   result.correspondences = lin.count;
-  result.hessian = lin.H;
+  result.hessian = clouds_hessian;
   job.T = T;
   const Accumulator fit = run(&Vgicp::FitnessChunk);
   result.fitness_points = fit.count;

@@ -48,6 +48,8 @@ Status LocalMapperConfig::Validate() const {
       !(odometry_rotation_sigma_min > 0) || !(odometry_sigma_per_m >= 0) ||
       !(odometry_rotation_sigma_per_m >= 0) || !(odometry_gap_inflation >= 1) ||
       !(odometry_gate_chi2 >= 0) || !(motion_seed_max_age_s >= 0) ||
+      !(tracking_voxel_m >= voxel_m) || !(tracking_prior_sigma_m > 0) ||
+      !(tracking_prior_sigma_rad > 0) ||
       room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 || max_plane_priors < 1 ||
       cloud_store_points < max_scan_points || odometry_capacity < 16 || !(odometry_max_gap_s > 0)) {
     return Error{Errc::kInvalidConfig,
@@ -92,7 +94,13 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   local_tree_.Init(local_n);
   local_map_.Init(local_n);
   vgicp_.Init(n);
-  for (auto* b : {&work_, &filtered_, &down_, &normals_, &stored_, &world_points_}) b->Init(n);
+  for (auto* b : {&work_, &filtered_, &down_, &normals_, &stored_, &world_points_, &track_down_,
+                  &track_normals_})
+    b->Init(n);
+  track_covariances_.Init(n);
+  track_tree_.Init(n);
+  have_track_ = false;
+  local_map_keyframe_ = kNoKeyframe;
   local_raw_.Init(config.local_map_keyframes * n);
   local_points_.Init(local_n);
   local_normals_.Init(local_n);
@@ -103,6 +111,7 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   sequence_.assign(slots, 0);
   keyframe_odometry_.assign(slots, Eigen::Isometry3d::Identity());
   recent_.assign(config.local_map_keyframes, 0);
+  deskew_poses_.fill(Eigen::Isometry3d::Identity());
   nearby_.assign(slots, {0.0, 0u});
   recent_scratch_.assign(slots, 0);
   prior_factors_.Init(config.max_plane_priors);
@@ -139,6 +148,18 @@ Matrix6d LocalMapper::OdometryInformation(const Eigen::Isometry3d& delta, bool a
 bool LocalMapper::Preprocess(const LidarScanView& scan,
                              const Eigen::Isometry3d& T_odom_start,
                              const Eigen::Isometry3d& T_odom_end) {
+  PrepareSweep(scan, T_odom_start, T_odom_end);
+  if (!voxel_.Downsample(filtered_.span(), config_.voxel_m, down_) || down_.size() < 100)
+    return false;
+  if (!tree_.Build(down_.span())) return false;
+  const Eigen::Vector3f viewpoint = config_.T_base_lidar.translation().cast<float>();
+  if (!EstimateCovariances(down_.span(), tree_, {}, normals_, covariances_, &viewpoint))
+    return false;
+  return true;
+}
+
+void LocalMapper::PrepareSweep(const LidarScanView& scan, const Eigen::Isometry3d& T_odom_start,
+                               const Eigen::Isometry3d& T_odom_end) {
   work_.clear();
   times_.clear();
   for (std::size_t i = 0; i < scan.points_lidar.size(); ++i) {
@@ -148,21 +169,32 @@ bool LocalMapper::Preprocess(const LidarScanView& scan,
     }
     static_cast<void>(times_.try_push_back(scan.time_offset_s[i]));
   }
-  // Deskew to the end of the sweep with the odometry's motion in the lidar frame.
-  const Eigen::Isometry3d T_start_end =
-      (T_odom_start * config_.T_base_lidar).inverse() * (T_odom_end * config_.T_base_lidar);
-  static_cast<void>(DeskewToEnd(work_.span(), times_.span(),
-                                std::max(1e-3, scan.end_s - scan.start_s), T_start_end));
+  // Deskew to the end of the sweep with the odometry's motion in the lidar frame, sampled
+  // across the sweep (a legged robot's body rocks within one sweep: deskew.hpp); where the
+  // odometry cannot say (a lookup fails), constant velocity from start to end.
+  const double duration_s = std::max(1e-3, scan.end_s - scan.start_s);
+  const Eigen::Isometry3d T_end_lidar_inv = (T_odom_end * config_.T_base_lidar).inverse();
+  bool sampled = true;
+  for (std::size_t k = 0; k < deskew_poses_.size() && sampled; ++k) {
+    const double t = scan.start_s + duration_s * static_cast<double>(k) /
+                                        static_cast<double>(deskew_poses_.size() - 1);
+    const auto at = k + 1 == deskew_poses_.size() ? odometry_.At(scan.end_s) : odometry_.At(t);
+    sampled = at.has_value();
+    if (sampled) deskew_poses_[k] = T_end_lidar_inv * at->T_odom_base * config_.T_base_lidar;
+  }
+  // The buffer must hold the caller's odometry (Relocalise passes a new odometry frame's).
+  sampled = sampled && deskew_poses_.back().isApprox(Eigen::Isometry3d::Identity(), 1e-6);
+  if (sampled) {
+    static_cast<void>(DeskewToEnd(work_.span(), times_.span(), duration_s,
+                                  std::span<const Eigen::Isometry3d>(deskew_poses_)));
+  } else {
+    const Eigen::Isometry3d T_start_end = (T_odom_start * config_.T_base_lidar).inverse() *
+                                          (T_odom_end * config_.T_base_lidar);
+    static_cast<void>(DeskewToEnd(work_.span(), times_.span(), duration_s, T_start_end));
+  }
   RangeFilter(work_.span(), config_.min_range_m, config_.max_range_m, filtered_);
   const Eigen::Affine3f T_base_lidar = config_.T_base_lidar.cast<float>();
   for (Eigen::Vector3f& p : filtered_) p = T_base_lidar * p;
-  if (!voxel_.Downsample(filtered_.span(), config_.voxel_m, down_) || down_.size() < 100)
-    return false;
-  if (!tree_.Build(down_.span())) return false;
-  const Eigen::Vector3f viewpoint = config_.T_base_lidar.translation().cast<float>();
-  if (!EstimateCovariances(down_.span(), tree_, {}, normals_, covariances_, &viewpoint))
-    return false;
-  return true;
 }
 
 // The last keyframes' stored clouds in the frame of keyframe `last`, downsampled, with their
@@ -174,6 +206,7 @@ bool LocalMapper::BuildLocalMap(std::uint32_t last) {
 
 // The clouds of `keyframes` (in that order, until local_raw_ is full) in the frame of `last`.
 bool LocalMapper::BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t> keyframes) {
+  local_map_keyframe_ = kNoKeyframe;  // EnsureLocalMap says which keyframe's it is
   const Eigen::Isometry3d T_last_map = graph_.keyframe_pose(last).inverse();
   local_raw_.clear();
   for (const std::uint32_t k : keyframes) {
@@ -211,9 +244,19 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   }
   const Eigen::Isometry3d T_odom_now = at_end->T_odom_base;
   const Eigen::Isometry3d delta = last_odometry_.inverse() * T_odom_now;
+  const bool across_gap = at_end->across_gap || at_start->across_gap;
+  // The motion since the last keyframe: tracked sweep by sweep, or the encoders'.
+  Eigen::Isometry3d motion = delta;
+  bool tracked = false;
+  if (have_keyframe_ && config_.track_scans) {
+    const std::uint64_t before = stats_.scans_tracked;
+    motion = Track(scan, at_start->T_odom_base, T_odom_now, across_gap);
+    tracked = stats_.scans_tracked > before;
+    T_map_odom_ = graph_.keyframe_pose(last_keyframe_) * motion * T_odom_now.inverse();
+  }
   if (have_keyframe_) {
-    const double angle = Eigen::AngleAxisd(delta.linear()).angle();
-    if (delta.translation().norm() < config_.keyframe_spacing_m &&
+    const double angle = Eigen::AngleAxisd(motion.linear()).angle();
+    if (motion.translation().norm() < config_.keyframe_spacing_m &&
         angle < config_.keyframe_angle_rad) {
       return ScanOutcome::kNotKeyframe;
     }
@@ -226,24 +269,30 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     return Error{Errc::kDegenerate, "keyframe scan has too few usable points"};
   }
   Stage(observer, MapperStage::kPreprocess);
-  const bool across_gap = at_end->across_gap || at_start->across_gap;
   Eigen::Isometry3d T_map_new = T_map_odom_ * T_odom_now;
   bool matched = false;
-  Eigen::Isometry3d T_last_new = delta;
+  Eigen::Isometry3d T_last_new = motion;
   Matrix6d match_information = Matrix6d::Identity();
   last_match_ = {};
-  if (have_keyframe_ && BuildLocalMap(last_keyframe_)) {
+  if (have_keyframe_ && EnsureLocalMap()) {
     fitness_limit_m2_ = fitness_gate_.Limit();
     stats_.scan_match_fitness_limit_m2 = fitness_limit_m2_;
     double fitness_m2 = 0;
-    MatchOutcome outcome = MatchFrom(delta, T_last_new, match_information, fitness_m2);
+    // Seeded by the tracked motion (or the encoders'), which also holds the directions the
+    // clouds leave free (VgicpPrior): along a corridor the match does not slide on noise.
+    VgicpPrior motion_prior;
+    motion_prior.T_target_source = motion;
+    motion_prior.information = OdometryInformation(delta, across_gap);
+    motion_prior.clouds_sigma_m = config_.scan_match_sigma_m;
+    MatchOutcome outcome =
+        MatchFrom(motion, T_last_new, match_information, fitness_m2, &motion_prior);
     // A step whose odometry disagrees with the pace the last match measured may be a slip:
     // VGICP from a guess 0.4 m off can stop part way and still pass every test, so the motion's
     // guess is registered too, and the better fit of the two accepted ones kept.
     Eigen::Isometry3d seed, T_motion;
     Matrix6d motion_information;
     double motion_fitness_m2 = 0;
-    if (MotionSeed(delta, scan.end_s, seed) &&
+    if (!tracked && MotionSeed(delta, scan.end_s, seed) &&
         MatchFrom(seed, T_motion, motion_information, motion_fitness_m2) == MatchOutcome::kAccepted &&
         (outcome != MatchOutcome::kAccepted || motion_fitness_m2 < fitness_m2)) {
       if (outcome == MatchOutcome::kAccepted) ++stats_.scan_match_motion_preferred;
@@ -281,7 +330,7 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     ++stats_.scan_match_rejected_failed;
   }
   Stage(observer, MapperStage::kScanMatching);
-  if (have_keyframe_ && !matched) T_map_new = graph_.keyframe_pose(last_keyframe_) * delta;
+  if (have_keyframe_ && !matched) T_map_new = graph_.keyframe_pose(last_keyframe_) * motion;
   auto added = graph_.AddKeyframe(scan.end_s, T_map_new);
   if (!added) {
     ++stats_.keyframes_refused;
@@ -374,6 +423,12 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   last_keyframe_ = id;
   last_odometry_ = T_odom_now;
   T_map_odom_ = graph_.keyframe_pose(id) * T_odom_now.inverse();
+  // Tracking restarts at the new keyframe, against its local map (built now, for the sweeps
+  // until the next keyframe and that keyframe's match).
+  have_track_ = true;
+  track_T_last_base_ = Eigen::Isometry3d::Identity();
+  track_T_odom_ = T_odom_now;
+  if (config_.track_scans) static_cast<void>(EnsureLocalMap());
   ++stats_.keyframes;
   return ScanOutcome::kKeyframe;
 }
@@ -391,9 +446,10 @@ const char* LocalMapper::ToString(MatchOutcome outcome) {
 
 LocalMapper::MatchOutcome LocalMapper::MatchFrom(const Eigen::Isometry3d& T_last_seed,
                                                  Eigen::Isometry3d& T_last_new,
-                                                 Matrix6d& information, double& fitness_m2) {
+                                                 Matrix6d& information, double& fitness_m2,
+                                                 const VgicpPrior* prior) {
   auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_, local_points_.span(),
-                             local_tree_, T_last_seed, config_.scan_matching);
+                             local_tree_, T_last_seed, config_.scan_matching, nullptr, prior);
   if (!result || !result->converged) return MatchOutcome::kFailed;
   fitness_m2 = result->fitness;
   if (result->fitness > fitness_limit_m2_) return MatchOutcome::kFitness;

@@ -58,6 +58,19 @@ Status PlaneMapper::Init(std::size_t max_planes, const PlaneAssociationConfig& c
   return Ok();
 }
 
+Eigen::Matrix3d PlaneObservationCovariance(const ExtractedPlane& p, double floor_m) {
+  const double floor2 = floor_m * floor_m;
+  // Centroid parameters from origin parameters: d_c = d + (alpha u + beta v).c.
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  K(2, 0) = p.basis_u.dot(p.centroid);
+  K(2, 1) = p.basis_v.dot(p.centroid);
+  Eigen::Matrix3d at_centroid = K * p.covariance * K.transpose();
+  for (int i = 0; i < 3; ++i) at_centroid(i, i) = std::max(at_centroid(i, i), floor2);
+  const Eigen::Matrix3d K_inv = K.inverse();
+  const Eigen::Matrix3d at_origin = K_inv * at_centroid * K_inv.transpose();
+  return 0.5 * (at_origin + at_origin.transpose());
+}
+
 Status PlaneMapper::Associate(SGraph& graph,
                               std::uint32_t keyframe,
                               std::span<const ExtractedPlane> planes) {
@@ -68,7 +81,6 @@ Status PlaneMapper::Associate(SGraph& graph,
                       config_.pose_sigma_rad * config_.pose_sigma_rad,
                       config_.pose_sigma_m * config_.pose_sigma_m)
           .asDiagonal();
-  const double floor2 = config_.covariance_floor_m * config_.covariance_floor_m;
   for (const ExtractedPlane& p : planes) {
     const PlaneClass cls = ClassOf(p);
     if (cls == PlaneClass::kWall && (p.u_max - p.u_min < config_.min_wall_length_m ||
@@ -82,8 +94,7 @@ Status PlaneMapper::Associate(SGraph& graph,
     z.d = p.d;
     z.basis_u = p.basis_u;
     z.basis_v = p.basis_v;
-    z.covariance = p.covariance;
-    for (int i = 0; i < 3; ++i) z.covariance(i, i) = std::max(z.covariance(i, i), floor2);
+    z.covariance = PlaneObservationCovariance(p, config_.covariance_floor_m);
     const WallExtent extent = cls == PlaneClass::kWall ? ExtentOf(p, T) : WallExtent{};
     const Eigen::Vector3d n_map = T.linear() * p.normal;
     const Eigen::Matrix3d S_inv = (z.covariance + pose_covariance).inverse();

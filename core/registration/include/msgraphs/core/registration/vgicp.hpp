@@ -36,6 +36,21 @@ struct VgicpConfig {
   Status Validate() const;
 };
 
+/// A prior on the transform (another sensor's measurement of it, e.g. encoder odometry), with
+/// its information in the registration's own units (over [rho; phi], right perturbation):
+/// directions the clouds constrain weakly (along a corridor) then stay where the prior puts
+/// them instead of sliding on noise; directions they constrain strongly follow the clouds. The
+/// result's `hessian` is the clouds' alone.
+struct VgicpPrior {
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  /// > 0: `information` is in metric units, and the clouds' Hessian (whose scale is the
+  /// covariances', not the sensor's noise) counts as information whose strongest translational
+  /// direction has this sigma, as the caller will report it (InformationFromHessian); the
+  /// prior is converted at the first linearisation. 0: `information` is in the Hessian's units.
+  double clouds_sigma_m = 0;
+};
+
 struct VgicpResult {
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
   bool converged = false;
@@ -61,7 +76,7 @@ class Vgicp {
                               std::span<const Eigen::Matrix3f> source_covariances, const GaussianVoxelMap& target_map,
                               std::span<const Eigen::Vector3f> target_points, const KdTree& target_tree,
                               const Eigen::Isometry3d& initial_guess, const VgicpConfig& config,
-                              const ParallelExecutor* executor = nullptr);
+                              const ParallelExecutor* executor = nullptr, const VgicpPrior* prior = nullptr);
 
  private:
   struct Accumulator {

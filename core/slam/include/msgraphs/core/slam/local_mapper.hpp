@@ -23,6 +23,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -90,6 +91,19 @@ struct LocalMapperConfig {
   /// pace over a stride or two; after a few unmatched seconds it says no more than the
   /// encoders). 0: off.
   double motion_seed_max_age_s = 3.0;
+  /// Scan tracking: every sweep, not only keyframes, is registered against the local map (a
+  /// coarse copy of it, tracking_voxel_m), seeded by the encoders' motion since the previous
+  /// sweep. A foot that slips misreports a step by up to half its length; between two sweeps
+  /// (0.1 s) that is centimetres, well inside VGICP's reach, where between two keyframes it
+  /// was 0.3-0.7 m. The keyframe's match is then seeded by the tracked motion, and keyframes
+  /// are spaced by it. The prior holds what the clouds do not constrain (along a corridor) at
+  /// the encoders' step, never tighter than tracking_prior_sigma_m / _rad: within one sweep a
+  /// slip puts the encoders up to 5 cm off (half a step at 1 m/s), which the clouds must be
+  /// able to correct wherever they constrain anything. Off: keyframes only, seeded by the
+  /// encoders and the last match's pace (motion_seed_max_age_s).
+  bool track_scans = true;
+  float tracking_voxel_m = 0.25f;  ///< a few thousand points: a few ms a sweep
+  double tracking_prior_sigma_m = 0.05, tracking_prior_sigma_rad = 0.01;
   /// Encoder odometry factor: sigma grows with the motion. Configuration values from the
   /// robot's odometry, not fitted: 3 % of the distance (a legged robot's encoders: 1-2 % scale
   /// error, twice that as margin) and 0.005 rad a metre (0.3 degrees, about three times the
@@ -188,6 +202,9 @@ struct LocalMapperStats {
   /// Of the accepted: fitter than the floor allows, let through by the robot's own outlier
   /// bound (FitnessGate); and that bound at the newest keyframe.
   std::uint64_t scan_match_above_floor = 0;
+  /// Sweeps registered by scan tracking, and those it could not (no local map, too few
+  /// points, or the registration refused): they take the encoders' motion.
+  std::uint64_t scans_tracked = 0, scans_untracked = 0;
   double scan_match_fitness_limit_m2 = 0;
   std::uint64_t loop_closures = 0, full_solves = 0;
   /// Keyframes the graph refused (its store full with nothing to sparsify, which a validated
@@ -299,6 +316,15 @@ class LocalMapper {
   bool Preprocess(const LidarScanView& scan,
                   const Eigen::Isometry3d& T_odom_start,
                   const Eigen::Isometry3d& T_odom_end);
+  /// Deskewed, range-filtered, in the base frame: filtered_.
+  void PrepareSweep(const LidarScanView& scan, const Eigen::Isometry3d& T_odom_start,
+                    const Eigen::Isometry3d& T_odom_end);
+  /// Scan tracking (scan_tracking.cpp): the base at this sweep's end in the last keyframe's
+  /// frame, registered when it can be, else the encoders' motion since the last sweep.
+  Eigen::Isometry3d Track(const LidarScanView& scan, const Eigen::Isometry3d& T_odom_start,
+                          const Eigen::Isometry3d& T_odom_end, bool across_gap);
+  /// The local map for the last keyframe, built if it is not (false when it cannot be).
+  bool EnsureLocalMap();
   bool BuildLocalMap(std::uint32_t last);
   bool BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t> keyframes);
   bool BuildMapNear(const Eigen::Vector2d& a_map, const Eigen::Vector2d& b_map, double radius_m);
@@ -309,7 +335,8 @@ class LocalMapper {
   /// The keyframe scan (down_) against the local map from `T_last_seed`; on acceptance the
   /// registered step and its information.
   MatchOutcome MatchFrom(const Eigen::Isometry3d& T_last_seed, Eigen::Isometry3d& T_last_new,
-                         Matrix6d& information, double& fitness_m2);
+                         Matrix6d& information, double& fitness_m2,
+                         const VgicpPrior* prior = nullptr);
   /// The step the last accepted match's motion predicts for a scan ending at end_s, with the
   /// odometry's step `delta` giving direction and rotation; false when there is none.
   bool MotionSeed(const Eigen::Isometry3d& delta, double end_s, Eigen::Isometry3d& seed) const;
@@ -340,9 +367,22 @@ class LocalMapper {
   std::vector<std::uint64_t> sequence_;               // per keyframe slot
   std::vector<Eigen::Isometry3d> keyframe_odometry_;  // per keyframe slot
   std::vector<std::uint32_t> recent_;
+  /// The sensor across a sweep, in its frame at the sweep's end: 17 instants, 6 ms apart for a
+  /// 10 Hz sweep, a third of the encoders' 50 Hz period (deskew.hpp).
+  std::array<Eigen::Isometry3d, 17> deskew_poses_;
   std::vector<std::pair<double, std::uint32_t>> nearby_;  // Relocalise: (distance, keyframe)
   std::vector<std::uint32_t> recent_scratch_;
   BoundedVector<std::uint32_t> prior_factors_;  // factor ids of the current plane priors
+  // Scan tracking: the base at the last tracked sweep in the last keyframe's frame, and the
+  // encoders there; the local map's keyframe (kNoKeyframe: none or overwritten).
+  static constexpr std::uint32_t kNoKeyframe = 0xFFFFFFFFu;
+  bool have_track_ = false;
+  Eigen::Isometry3d track_T_last_base_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d track_T_odom_ = Eigen::Isometry3d::Identity();
+  std::uint32_t local_map_keyframe_ = kNoKeyframe;
+  BoundedVector<Eigen::Vector3f> track_down_, track_normals_;
+  BoundedVector<Eigen::Matrix3f> track_covariances_;
+  KdTree track_tree_;
   std::uint64_t next_sequence_ = 1;
   bool have_keyframe_ = false;
   std::uint32_t last_keyframe_ = 0;

@@ -61,6 +61,19 @@ struct WallExtent {
   bool valid = false;
 };
 
+/// The covariance a plane observation enters the graph with: the fit's, floored per axis at
+/// `floor_m` (metres for the offset, radians for the two angles) where the plane was seen, its
+/// centroid, not at the keyframe's origin where the measurement is expressed. A wall patch seen
+/// metres along the wall fixes its offset well where it is and its angle less well, so the
+/// offset at the origin inherits the angle's error times that lever (d at the origin = d at the
+/// centroid - (alpha u + beta v).c). Flooring the origin's offset alone said it was precise:
+/// with the VLP-16's 3 cm range noise along oblique rays, a patch's fitted normal leans towards
+/// the line of sight by a few tenths of a degree (errors in variables), within the angle floor,
+/// and carried 3 m to the origin that was a 1-2 cm bias (walls seen from afar came out closer).
+/// With the encoders replaced by the truth, a robot's map shrank by 0.56 % and its ATE was
+/// 5.1 cm; floored at the centroid, 0.18 % and 1.7 cm (docs/s-graph.md, "Plane covariance").
+Eigen::Matrix3d PlaneObservationCovariance(const ExtractedPlane& p, double floor_m);
+
 class PlaneMapper {
  public:
   Status Init(std::size_t max_planes, const PlaneAssociationConfig& config);
