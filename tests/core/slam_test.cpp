@@ -472,6 +472,64 @@ TEST(LocalMapper, AFootSlipBetweenKeyframesIsTrackedSweepBySweep) {
   EXPECT_GE(tracked.odometry_slips, 1u);
 }
 
+// A restarted node rebuilds its mapper from the journaled keyframe scans alone (the sweeps
+// between them are not kept). Each keyframe carries the motion scan tracking gave it; replayed
+// with it, the rebuilt map is the live one: the same keyframes at the same poses.
+TEST(LocalMapper, KeyframesReplayedWithTheirTrackedMotionRebuildTheLiveMap) {
+  LocalMapperConfig config = SmallConfig(32, 256);
+  LocalMapper live, rebuilt;
+  ASSERT_TRUE(live.Init(config));
+  ASSERT_TRUE(rebuilt.Init(config));
+  auto truth_at = [](double t) {
+    Eigen::Isometry3d T = Pose(2.0 + t, 4.0 + 0.3 * std::sin(0.5 * t), 0.1 + 0.05 * t);
+    T.translation().z() = 0.5;
+    return T;
+  };
+  constexpr std::size_t kPoints = 6000;
+  std::vector<float> times(kPoints, 0.1f);
+  std::vector<std::pair<double, Eigen::Isometry3d>> odometry;
+  for (double t = 0; t <= 4.2; t += 0.02) {
+    Eigen::Isometry3d T = truth_at(0).inverse() * truth_at(t);
+    T.translation() *= 1.04;  // the encoders' scale error
+    odometry.emplace_back(t, T);
+  }
+  std::size_t fed = 0;
+  std::vector<std::pair<std::vector<Eigen::Vector3f>, LocalMapper::KeyframeMotion>> journal;
+  std::vector<double> journal_end;
+  for (int k = 1; k <= 40; ++k) {
+    const double t = 0.1 * k;
+    for (; fed < odometry.size() && odometry[fed].first <= t + 0.05; ++fed)
+      ASSERT_TRUE(live.AddOdometry(odometry[fed].first, odometry[fed].second));
+    auto points = ScanAt(truth_at(t), config, static_cast<std::uint32_t>(k), kPoints);
+    auto outcome = live.AddScan({points, times, t - 0.1, t});
+    ASSERT_TRUE(outcome);
+    if (*outcome == ScanOutcome::kKeyframe) {
+      journal.emplace_back(std::move(points), live.last_keyframe_motion());
+      journal_end.push_back(t);
+    }
+  }
+  ASSERT_GE(journal.size(), 3u);
+  fed = 0;
+  for (std::size_t i = 0; i < journal.size(); ++i) {
+    const double t = journal_end[i];
+    for (; fed < odometry.size() && odometry[fed].first <= t + 0.05; ++fed)
+      ASSERT_TRUE(rebuilt.AddOdometry(odometry[fed].first, odometry[fed].second));
+    auto outcome = rebuilt.ReplayKeyframe({journal[i].first, times, t - 0.1, t}, journal[i].second);
+    ASSERT_TRUE(outcome);
+    EXPECT_EQ(*outcome, ScanOutcome::kKeyframe);
+  }
+  const SGraph& a = live.graph();
+  const SGraph& b = rebuilt.graph();
+  ASSERT_EQ(a.keyframe_slots(), b.keyframe_slots());
+  for (std::uint32_t k = 0; k < a.keyframe_slots(); ++k) {
+    EXPECT_DOUBLE_EQ(a.keyframe_stamp(k), b.keyframe_stamp(k));
+    EXPECT_LT((a.keyframe_pose(k).translation() - b.keyframe_pose(k).translation()).norm(), 1e-6);
+  }
+  LocalMapper::KeyframeMotion bad;
+  bad.T_last_new.linear()(0, 0) = 2;
+  EXPECT_FALSE(rebuilt.ReplayKeyframe({journal[0].first, times, 9.9, 10.0}, bad));
+}
+
 class Relocalisation : public ::testing::TestWithParam<double> {};
 
 TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {

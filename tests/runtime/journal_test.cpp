@@ -31,6 +31,12 @@ struct Collect final : JournalSink {
   void OnMessage(core::CollabMessageType, std::span<const std::uint8_t> b) override {
     messages.emplace_back(b.begin(), b.end());
   }
+  std::vector<std::pair<double, bool>> motions;
+  Eigen::Isometry3d last_motion = Eigen::Isometry3d::Identity();
+  void OnMotion(double end_s, const Eigen::Isometry3d& T, bool tracked) override {
+    motions.emplace_back(end_s, tracked);
+    last_motion = T;
+  }
 };
 
 std::string TempPath() {
@@ -58,13 +64,21 @@ TEST(Journal, RoundTripsEveryRecordWithinItsResolution) {
     ASSERT_TRUE(w->Finish());
     const std::uint8_t bytes[] = {1, 2, 3};
     ASSERT_TRUE(w->Message(core::CollabMessageType::kRoomDescriptor, bytes));
+    Eigen::Isometry3d motion(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+    motion.translation() << 1.05, -0.02, 0.001;
+    ASSERT_TRUE(w->Motion(11.1, motion, true));
     ASSERT_TRUE(w->Sync());
   }
   Collect c;
   auto r = ReplayJournal(path, 3, c);
   ASSERT_TRUE(r);
   EXPECT_TRUE(r->stopped.empty()) << r->stopped;
-  EXPECT_EQ(r->records, 5u);
+  EXPECT_EQ(r->records, 6u);
+  ASSERT_EQ(c.motions.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.motions[0].first, 11.1);
+  EXPECT_TRUE(c.motions[0].second);
+  EXPECT_NEAR(c.last_motion.translation().x(), 1.05, 1e-12);  // f64: exact
+  EXPECT_EQ(r->motions, 1u);
   ASSERT_EQ(c.scans.size(), 1u);
   ASSERT_EQ(c.scans[0].size(), 2u);
   EXPECT_NEAR(c.scans[0][0].x(), 1.2344f, 0.0006f);  // millimetres

@@ -190,7 +190,7 @@ Expected<VgicpResult> Vgicp::Align(std::span<const Eigen::Vector3f> source_point
       const double strongest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Htt).eigenvalues().maxCoeff();
       prior_information *= strongest > 0 ? prior->clouds_sigma_m * prior->clouds_sigma_m * strongest : 0.0;
     }
-    lin = evaluate(T, true);  // now with the prior
+    add_prior(T, lin, true);  // the first linearisation, now with the prior
   }
   double lambda = config.initial_lambda_factor * lin.H.diagonal().maxCoeff();
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {

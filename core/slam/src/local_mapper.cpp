@@ -48,7 +48,7 @@ Status LocalMapperConfig::Validate() const {
       !(odometry_rotation_sigma_min > 0) || !(odometry_sigma_per_m >= 0) ||
       !(odometry_rotation_sigma_per_m >= 0) || !(odometry_gap_inflation >= 1) ||
       !(odometry_gate_chi2 >= 0) || !(motion_seed_max_age_s >= 0) ||
-      !(tracking_voxel_m >= voxel_m) || !(tracking_prior_sigma_m > 0) ||
+      (track_scans && !(tracking_voxel_m >= voxel_m)) || !(tracking_prior_sigma_m > 0) ||
       !(tracking_prior_sigma_rad > 0) ||
       room_update_every_keyframes < 1 || full_solve_every_keyframes < 1 || max_plane_priors < 1 ||
       cloud_store_points < max_scan_points || odometry_capacity < 16 || !(odometry_max_gap_s > 0)) {
@@ -100,7 +100,10 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   track_covariances_.Init(n);
   track_tree_.Init(n);
   have_track_ = false;
-  local_map_keyframe_ = kNoKeyframe;
+  local_map_keyframe_ = local_map_failed_ = kNoKeyframe;
+  prepared_ = false;
+  untracked_sweeps_ = 0;
+  keyframe_motion_ = {};
   local_raw_.Init(config.local_map_keyframes * n);
   local_points_.Init(local_n);
   local_normals_.Init(local_n);
@@ -147,8 +150,9 @@ Matrix6d LocalMapper::OdometryInformation(const Eigen::Isometry3d& delta, bool a
 
 bool LocalMapper::Preprocess(const LidarScanView& scan,
                              const Eigen::Isometry3d& T_odom_start,
-                             const Eigen::Isometry3d& T_odom_end) {
-  PrepareSweep(scan, T_odom_start, T_odom_end);
+                             const Eigen::Isometry3d& T_odom_end, bool buffered) {
+  if (!prepared_) PrepareSweep(scan, T_odom_start, T_odom_end, buffered);
+  prepared_ = false;
   if (!voxel_.Downsample(filtered_.span(), config_.voxel_m, down_) || down_.size() < 100)
     return false;
   if (!tree_.Build(down_.span())) return false;
@@ -159,7 +163,7 @@ bool LocalMapper::Preprocess(const LidarScanView& scan,
 }
 
 void LocalMapper::PrepareSweep(const LidarScanView& scan, const Eigen::Isometry3d& T_odom_start,
-                               const Eigen::Isometry3d& T_odom_end) {
+                               const Eigen::Isometry3d& T_odom_end, bool buffered) {
   work_.clear();
   times_.clear();
   for (std::size_t i = 0; i < scan.points_lidar.size(); ++i) {
@@ -174,7 +178,7 @@ void LocalMapper::PrepareSweep(const LidarScanView& scan, const Eigen::Isometry3
   // odometry cannot say (a lookup fails), constant velocity from start to end.
   const double duration_s = std::max(1e-3, scan.end_s - scan.start_s);
   const Eigen::Isometry3d T_end_lidar_inv = (T_odom_end * config_.T_base_lidar).inverse();
-  bool sampled = true;
+  bool sampled = buffered;
   for (std::size_t k = 0; k < deskew_poses_.size() && sampled; ++k) {
     const double t = scan.start_s + duration_s * static_cast<double>(k) /
                                         static_cast<double>(deskew_poses_.size() - 1);
@@ -182,8 +186,6 @@ void LocalMapper::PrepareSweep(const LidarScanView& scan, const Eigen::Isometry3
     sampled = at.has_value();
     if (sampled) deskew_poses_[k] = T_end_lidar_inv * at->T_odom_base * config_.T_base_lidar;
   }
-  // The buffer must hold the caller's odometry (Relocalise passes a new odometry frame's).
-  sampled = sampled && deskew_poses_.back().isApprox(Eigen::Isometry3d::Identity(), 1e-6);
   if (sampled) {
     static_cast<void>(DeskewToEnd(work_.span(), times_.span(), duration_s,
                                   std::span<const Eigen::Isometry3d>(deskew_poses_)));
@@ -230,7 +232,20 @@ bool LocalMapper::BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t
 }
 
 Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObserver* observer) {
+  return AddScanImpl(scan, observer, nullptr);
+}
+
+Expected<ScanOutcome> LocalMapper::ReplayKeyframe(const LidarScanView& scan,
+                                                  const KeyframeMotion& motion) {
+  if (!IsValidRigidTransform(motion.T_last_new, 1e-6))
+    return Error{Errc::kInvalidArgument, "replay: the keyframe's motion is not a rigid transform"};
+  return AddScanImpl(scan, nullptr, &motion);
+}
+
+Expected<ScanOutcome> LocalMapper::AddScanImpl(const LidarScanView& scan, StageObserver* observer,
+                                               const KeyframeMotion* replay) {
   ++stats_.scans;
+  prepared_ = false;
   if (scan.points_lidar.size() != scan.time_offset_s.size() || !std::isfinite(scan.start_s) ||
       !std::isfinite(scan.end_s) || scan.end_s < scan.start_s) {
     ++stats_.bad_scans;
@@ -248,13 +263,17 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   // The motion since the last keyframe: tracked sweep by sweep, or the encoders'.
   Eigen::Isometry3d motion = delta;
   bool tracked = false;
-  if (have_keyframe_ && config_.track_scans) {
+  if (replay != nullptr) {
+    // As the live run made it: no tracking, no spacing test.
+    motion = replay->T_last_new;
+    tracked = replay->tracked;
+  } else if (have_keyframe_ && config_.track_scans) {
     const std::uint64_t before = stats_.scans_tracked;
     motion = Track(scan, at_start->T_odom_base, T_odom_now, across_gap);
     tracked = stats_.scans_tracked > before;
     T_map_odom_ = graph_.keyframe_pose(last_keyframe_) * motion * T_odom_now.inverse();
   }
-  if (have_keyframe_) {
+  if (have_keyframe_ && replay == nullptr) {
     const double angle = Eigen::AngleAxisd(motion.linear()).angle();
     if (motion.translation().norm() < config_.keyframe_spacing_m &&
         angle < config_.keyframe_angle_rad) {
@@ -264,7 +283,7 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   }
   // ---- a keyframe ----
   if (observer != nullptr) observer->KeyframeStarted();
-  if (!Preprocess(scan, at_start->T_odom_base, T_odom_now)) {
+  if (!Preprocess(scan, at_start->T_odom_base, T_odom_now, true)) {
     ++stats_.bad_scans;
     return Error{Errc::kDegenerate, "keyframe scan has too few usable points"};
   }
@@ -282,7 +301,7 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     // clouds leave free (VgicpPrior): along a corridor the match does not slide on noise.
     VgicpPrior motion_prior;
     motion_prior.T_target_source = motion;
-    motion_prior.information = OdometryInformation(delta, across_gap);
+    motion_prior.information = HoldingPrior(delta, across_gap);
     motion_prior.clouds_sigma_m = config_.scan_match_sigma_m;
     MatchOutcome outcome =
         MatchFrom(motion, T_last_new, match_information, fitness_m2, &motion_prior);
@@ -419,6 +438,8 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
     motion_s_ = scan.end_s - graph_.keyframe_stamp(last_keyframe_);
     motion_end_s_ = scan.end_s;
   }
+  keyframe_motion_.T_last_new = motion;
+  keyframe_motion_.tracked = tracked;
   have_keyframe_ = true;
   last_keyframe_ = id;
   last_odometry_ = T_odom_now;
@@ -428,6 +449,7 @@ Expected<ScanOutcome> LocalMapper::AddScan(const LidarScanView& scan, StageObser
   have_track_ = true;
   track_T_last_base_ = Eigen::Isometry3d::Identity();
   track_T_odom_ = T_odom_now;
+  untracked_sweeps_ = 0;
   if (config_.track_scans) static_cast<void>(EnsureLocalMap());
   ++stats_.keyframes;
   return ScanOutcome::kKeyframe;
@@ -557,7 +579,10 @@ Status LocalMapper::Finish() {
   auto report = graph_.Solve(SolveKind::kFull);
   if (!report) return report.error();
   ++stats_.full_solves;
-  T_map_odom_ = graph_.keyframe_pose(last_keyframe_) * last_odometry_.inverse();
+  // The solve moved the keyframes the local map was built from.
+  local_map_keyframe_ = local_map_failed_ = kNoKeyframe;
+  T_map_odom_ = have_track_ ? graph_.keyframe_pose(last_keyframe_) * track_T_last_base_ * track_T_odom_.inverse()
+                            : graph_.keyframe_pose(last_keyframe_) * last_odometry_.inverse();
   return Ok();
 }
 

@@ -105,7 +105,8 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
       !search.T_odom_from.matrix().allFinite() || !search.T_odom_to.matrix().allFinite()) {
     return Error{Errc::kInvalidArgument, "relocalise: bad scan or search"};
   }
-  if (!Preprocess(scan, T_new_start, T_new_end))
+  prepared_ = false;
+  if (!Preprocess(scan, T_new_start, T_new_end, false))
     return Error{Errc::kDegenerate, "relocalise: too few usable points"};
   // Seeds relative to the last keyframe (the odometry frame agrees with the map locally), laid
   // out in the gravity-aligned map: at the height where the node stopped (a legged robot walks

@@ -250,7 +250,7 @@ bool ParseNodeConfig(const std::string& text,
   r.Number("mapping", "scan_match_fitness_outlier_z", 0.0, 100.0, c.mapper.scan_match_fitness_outlier_z);
   // Scan tracking: every sweep registered against the local map (local_mapper.hpp, track_scans).
   r.Bool("mapping", "track_scans", c.mapper.track_scans);
-  r.Float("mapping", "tracking_voxel_m", 0.05, 2.0, c.mapper.tracking_voxel_m);
+  r.Float("mapping", "tracking_voxel_m", 0.1, 2.0, c.mapper.tracking_voxel_m);
   r.Number("mapping", "tracking_prior_sigma_m", 1e-3, 10.0, c.mapper.tracking_prior_sigma_m);
   r.Number("mapping", "tracking_prior_sigma_rad", 1e-4, 3.0, c.mapper.tracking_prior_sigma_rad);
   // Room segmentation (RoomSegmentationConfig): the building's doorways and corridors, not the

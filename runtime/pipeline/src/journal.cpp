@@ -208,6 +208,14 @@ Status JournalWriter::Priors(std::span<const core::PlanePrior> priors) {
 
 Status JournalWriter::Finish() { return Write(JournalRecord::kFinish, {}); }
 
+Status JournalWriter::Motion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked) {
+  Out o(buffer_);
+  o.F64(end_s);
+  PutPose(o, T_last_new);
+  o.U8(tracked ? 1 : 0);
+  return Write(JournalRecord::kMotion, buffer_);
+}
+
 Status JournalWriter::Message(core::CollabMessageType type, std::span<const std::uint8_t> bytes) {
   Out o(buffer_);
   o.U8(static_cast<std::uint8_t>(type));
@@ -316,6 +324,16 @@ Expected<JournalReplay> ReplayJournal(const std::string& path,
         if (!(ok = t < core::kCollabMessageTypes)) break;
         sink.OnMessage(static_cast<core::CollabMessageType>(t), in.Rest());
         ++r.messages;
+        break;
+      }
+      case JournalRecord::kMotion: {
+        if (!(ok = length == 65)) break;
+        const double end = in.F64();
+        const Eigen::Isometry3d T = GetPose(in);
+        const std::uint8_t tracked = in.U8();
+        if (!(ok = tracked <= 1 && std::isfinite(end))) break;
+        sink.OnMotion(end, T, tracked == 1);
+        ++r.motions;
         break;
       }
       default:

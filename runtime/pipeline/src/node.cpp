@@ -42,7 +42,20 @@ class Restore final : public JournalSink {
               std::span<const float> times,
               double start_s,
               double end_s) override {
-    static_cast<void>(mapper_.AddScan({points, times, start_s, end_s}));
+    // A keyframe made as it was live (its tracked motion), or, from a journal written before
+    // scan tracking, through AddScan.
+    if (have_motion_ && motion_end_s_ == end_s) {
+      static_cast<void>(mapper_.ReplayKeyframe({points, times, start_s, end_s}, motion_));
+    } else {
+      static_cast<void>(mapper_.AddScan({points, times, start_s, end_s}));
+    }
+    have_motion_ = false;
+  }
+  void OnMotion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked) override {
+    motion_.T_last_new = T_last_new;
+    motion_.tracked = tracked;
+    motion_end_s_ = end_s;
+    have_motion_ = true;
   }
   void OnPriors(std::span<const core::PlanePrior> priors) override {
     static_cast<void>(mapper_.SetPlanePriors(priors));
@@ -57,6 +70,9 @@ class Restore final : public JournalSink {
   core::LocalMapper& mapper_;
   core::CollabSession& session_;
   NullOutbox outbox_;
+  core::LocalMapper::KeyframeMotion motion_;
+  double motion_end_s_ = 0;
+  bool have_motion_ = false;
 };
 
 }  // namespace

@@ -228,9 +228,12 @@ void Node::Impl::SlamLoop() {
     const double end_s = scan->end_s;
     if (outcome && *outcome == core::ScanOutcome::kKeyframe) {
       keyframe_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
-      // Only keyframes change the mapper: only they are journaled.
+      // Only keyframes change the mapper's graph: only they are journaled, each with the motion
+      // the sweeps before it tracked (replay makes the same keyframe from it).
+      const core::LocalMapper::KeyframeMotion& motion = mapper.last_keyframe_motion();
       Journal([&](JournalWriter& j) {
-        return static_cast<bool>(j.Scan(view.points_lidar, view.time_offset_s, view.start_s,
+        return static_cast<bool>(j.Motion(view.end_s, motion.T_last_new, motion.tracked)) &&
+               static_cast<bool>(j.Scan(view.points_lidar, view.time_offset_s, view.start_s,
                                         view.end_s, config.mapper.max_range_m));
       });
       if (unpublished_keyframes.size() < unpublished_keyframes.capacity())

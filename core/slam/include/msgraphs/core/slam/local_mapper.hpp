@@ -262,6 +262,20 @@ class LocalMapper {
   /// kNoOdometry: the scan's end is not inside the buffered odometry (feed odometry first).
   Expected<ScanOutcome> AddScan(const LidarScanView& scan, StageObserver* observer = nullptr);
 
+  /// How the newest keyframe was made, for a journal that rebuilds the mapper from its keyframe
+  /// scans alone (runtime's checkpoint): its motion since the previous keyframe as tracked
+  /// then, and whether a sweep registration gave it. Scan tracking makes the keyframes depend
+  /// on every sweep, which the journal does not keep.
+  struct KeyframeMotion {
+    Eigen::Isometry3d T_last_new = Eigen::Isometry3d::Identity();
+    bool tracked = false;
+  };
+  const KeyframeMotion& last_keyframe_motion() const { return keyframe_motion_; }
+
+  /// Replay of a journaled keyframe: `scan` becomes a keyframe made exactly as it was live, with
+  /// `motion` in place of tracking and of the spacing test. kNoOdometry as AddScan.
+  Expected<ScanOutcome> ReplayKeyframe(const LidarScanView& scan, const KeyframeMotion& motion);
+
   /// Where `scan` was taken, in this mapper's odometry frame, when the odometry cannot say: a
   /// restarted node whose odometry integration began again at identity while the robot moved.
   /// `T_new_start`/`T_new_end` are the new odometry at the scan's start and end (only their
@@ -285,8 +299,8 @@ class LocalMapper {
   Status SetPlanePriors(std::span<const PlanePrior> priors);
 
   const SGraph& graph() const { return graph_; }
-  /// The map-from-odometry correction at the newest keyframe: T_map_base = T_map_odom *
-  /// T_odom_base.
+  /// The map-from-odometry correction: T_map_base = T_map_odom * T_odom_base. At the newest
+  /// keyframe, and with scan tracking at the newest tracked sweep.
   Eigen::Isometry3d T_map_odom() const { return T_map_odom_; }
   /// Encoder odometry at a keyframe (for the encoder-only baseline of the same keyframes).
   /// Identity for an id beyond the graph's store.
@@ -313,12 +327,19 @@ class LocalMapper {
   void Stage(StageObserver* observer, MapperStage stage) const {
     if (observer != nullptr) observer->StageEnded(stage);
   }
+  /// `buffered`: deskew along this mapper's odometry buffer (AddScan); false: the caller's
+  /// start and end poses only (Relocalise: a new odometry frame the buffer does not hold).
   bool Preprocess(const LidarScanView& scan,
                   const Eigen::Isometry3d& T_odom_start,
-                  const Eigen::Isometry3d& T_odom_end);
+                  const Eigen::Isometry3d& T_odom_end, bool buffered);
   /// Deskewed, range-filtered, in the base frame: filtered_.
   void PrepareSweep(const LidarScanView& scan, const Eigen::Isometry3d& T_odom_start,
-                    const Eigen::Isometry3d& T_odom_end);
+                    const Eigen::Isometry3d& T_odom_end, bool buffered);
+  Expected<ScanOutcome> AddScanImpl(const LidarScanView& scan, StageObserver* observer,
+                                    const KeyframeMotion* replay);
+  /// The prior that holds what the clouds leave free: the encoders' information for `step`,
+  /// never tighter than the tracking floor.
+  Matrix6d HoldingPrior(const Eigen::Isometry3d& step, bool across_gap) const;
   /// Scan tracking (scan_tracking.cpp): the base at this sweep's end in the last keyframe's
   /// frame, registered when it can be, else the encoders' motion since the last sweep.
   Eigen::Isometry3d Track(const LidarScanView& scan, const Eigen::Isometry3d& T_odom_start,
@@ -380,6 +401,10 @@ class LocalMapper {
   Eigen::Isometry3d track_T_last_base_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d track_T_odom_ = Eigen::Isometry3d::Identity();
   std::uint32_t local_map_keyframe_ = kNoKeyframe;
+  std::uint32_t local_map_failed_ = kNoKeyframe;  ///< a build failed for it: not retried per sweep
+  bool prepared_ = false;  ///< filtered_ holds this scan's sweep (tracking prepared it)
+  std::uint32_t untracked_sweeps_ = 0;  ///< since the last tracked sweep or keyframe
+  KeyframeMotion keyframe_motion_;
   BoundedVector<Eigen::Vector3f> track_down_, track_normals_;
   BoundedVector<Eigen::Matrix3f> track_covariances_;
   KdTree track_tree_;

@@ -4,8 +4,9 @@
 //
 // Why a journal of inputs rather than a snapshot of the S-Graph: the local mapper's state is a
 // function of its keyframe scans, the odometry, the wall priors it was given and its Finish
-// calls (scans that are not keyframes change nothing), and the session's of the peers'
-// messages. Replaying those rebuilds every part of it (graph, stored clouds, planes, rooms,
+// calls, and the session's of the peers' messages. Scans that are not keyframes change only
+// the scan tracking, whose result a keyframe carries as its motion (kMotion, written before
+// its kScan): replay makes the keyframe from it (LocalMapper::ReplayKeyframe). Replaying those rebuilds every part of it (graph, stored clouds, planes, rooms,
 // loop-closure candidates, free-space grid) without a serialiser per class that would have to
 // follow each of them. The cost: a restart replays the keyframes (about 50 ms each here).
 //
@@ -23,6 +24,9 @@
 //   kFinish    (empty)
 //   kMessage   type u8, bytes: a collab message from a peer (room clouds are not kept: they
 //              are requested again when needed)
+//   kMotion    end f64, x y z f64, qx qy qz qw f64, tracked u8: the next keyframe's motion since
+//              the previous one, as tracked live (65 bytes). A journal without them (written
+//              before scan tracking) replays its keyframe scans through AddScan.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -42,7 +46,8 @@ enum class JournalRecord : std::uint8_t {
   kScan = 2,
   kPriors = 3,
   kFinish = 4,
-  kMessage = 5
+  kMessage = 5,
+  kMotion = 6
 };
 
 class JournalWriter {
@@ -65,6 +70,8 @@ class JournalWriter {
   Status Priors(std::span<const core::PlanePrior> priors);
   Status Finish();
   Status Message(core::CollabMessageType type, std::span<const std::uint8_t> bytes);
+  /// The motion of the keyframe whose scan follows (ending at `end_s`).
+  Status Motion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked);
   /// fsync: everything written so far survives a power cut.
   Status Sync();
   std::uint64_t bytes() const { return bytes_; }
@@ -81,7 +88,8 @@ class JournalWriter {
 /// What replay found.
 struct JournalReplay {
   std::uint64_t valid_bytes = 0;  ///< where the good records end (the writer appends there)
-  std::uint64_t records = 0, odometry = 0, scans = 0, priors = 0, finishes = 0, messages = 0;
+  std::uint64_t records = 0, odometry = 0, scans = 0, priors = 0, finishes = 0, messages = 0,
+                motions = 0;
   double last_scan_end_s = -1, last_odometry_s = -1;
   std::string stopped;  ///< empty when the file ended cleanly, else why replay stopped early
 };
@@ -98,6 +106,7 @@ class JournalSink {
   virtual void OnPriors(std::span<const core::PlanePrior> priors) = 0;
   virtual void OnFinish() = 0;
   virtual void OnMessage(core::CollabMessageType type, std::span<const std::uint8_t> bytes) = 0;
+  virtual void OnMotion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked) = 0;
 };
 
 /// Replays `path` into `sink`. A missing file is an empty journal; a header for another robot
