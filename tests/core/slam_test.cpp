@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <string>
 
 #include "alloc_counter.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
@@ -593,6 +594,20 @@ TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
   EXPECT_LT((found_wide.translation() - walk.truth[14].translation()).norm(), 0.05);
   EXPECT_LT(Eigen::AngleAxisd(found_wide.linear().transpose() * walk.truth[14].linear()).angle(),
             0.01);
+  // At the middle of the box room the scan aligns as well turned half round: off the predicted
+  // path that is an ambiguity, never an answer (the node then resumes on the robot's motion).
+  Eigen::Isometry3d T_middle = Pose(0.5 * kSx, 0.5 * kSy, 0.3);
+  T_middle.translation().z() = 0.5;
+  const Eigen::Vector3d middle_from_stop =
+      T_middle.translation() - (T_map_odom * walk.odometry[11]).translation();
+  RelocaliseSearch around = reach;
+  around.reach_m = middle_from_stop.head<2>().norm() + 1.0;
+  const auto middle_points = ScanAt(T_middle, config, 16);
+  auto twofold = mapper.Relocalise({middle_points, times, 23.9, 24.0}, T_new, T_new, around);
+  ASSERT_FALSE(twofold);
+  EXPECT_EQ(twofold.error().code, Errc::kNotConverged);
+  EXPECT_NE(std::string(twofold.error().detail).find("ambiguous"), std::string::npos)
+      << twofold.error().detail;
   // Without a keyframe there is nothing to relocalise against.
   LocalMapper empty;
   ASSERT_TRUE(empty.Init(config));

@@ -136,18 +136,27 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
                         ? static_cast<int>(std::floor(search.yaw_rad / search.yaw_step_rad + 1e-9))
                         : 0;
   Relocalisation best;
+  const double apart_m = 2 * search.step_m + 1e-6, apart_rad = 2 * search.yaw_step_rad + 1e-6;
   // The best few seeds registered by VGICP; the lowest fitness within the scan-matching
-  // thresholds wins.
-  const auto register_best = [&](const SeedRanking& ranking) {
+  // thresholds wins. With `unique`, it wins only if no other place passes too: fitness does
+  // not tell a corridor's look-alike stretches apart (a scan into space the map saw from afar
+  // fits worse than one laid back onto the mapped corridor), so off the predicted path two
+  // places that both align are an ambiguity, not an answer (the caller then resumes on the
+  // motion the robot had).
+  bool ambiguous = false;
+  const auto register_best = [&](const SeedRanking& ranking, bool unique) {
     bool found = false;
     double best_fitness = config_.scan_match_max_fitness_m2;
     const double min_overlap = config_.scan_match_min_overlap * static_cast<double>(down_.size());
+    std::array<Eigen::Isometry3d, 8> passed;
+    std::size_t passed_count = 0;
     for (std::size_t k = 0; k < ranking.size(); ++k) {
       auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_,
                                  local_points_.span(), local_tree_, ranking.seed(k),
                                  config_.scan_matching);
       ++best.registrations;
-      if (!result || !result->converged || !(result->fitness < best_fitness) ||
+      if (!result || !result->converged ||
+          !(result->fitness < config_.scan_match_max_fitness_m2) ||
           static_cast<double>(result->correspondences) < min_overlap) {
         continue;
       }
@@ -158,14 +167,26 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
           (at_map - from_map).head<2>().norm() > search.reach_m + search.step_m) {
         continue;
       }
+      if (passed_count < passed.size()) passed[passed_count++] = result->T_target_source;
+      if (!(result->fitness < best_fitness)) continue;
       best_fitness = result->fitness;
       best.fitness_m2 = result->fitness;
       best.T_odom_base = last_odometry_ * result->T_target_source;
       found = true;
     }
+    if (found && unique) {
+      const Eigen::Isometry3d T_last_best = last_odometry_.inverse() * best.T_odom_base;
+      for (std::size_t k = 0; k < passed_count; ++k) {
+        const Eigen::Isometry3d d = T_last_best.inverse() * passed[k];
+        if (d.translation().head<2>().norm() > apart_m ||
+            Eigen::AngleAxisd(d.linear()).angle() > apart_rad) {
+          ambiguous = true;
+          return false;
+        }
+      }
+    }
     return found;
   };
-  const double apart_m = 2 * search.step_m + 1e-6, apart_rad = 2 * search.yaw_step_rad + 1e-6;
 
   // 1. Along the segment, one step beyond each end, lateral_m to either side, headings
   //    interpolated along it.
@@ -193,7 +214,7 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
         }
       }
     }
-    if (register_best(ranking)) return best;
+    if (register_best(ranking, false)) return best;
   }
   if (search.reach_m <= 0) {
     if (!have_map) return Error{Errc::kDegenerate, "relocalise: no map near the search"};
@@ -223,7 +244,9 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
       }
     }
   }
-  if (register_best(ranking)) return best;
+  if (register_best(ranking, true)) return best;
+  if (ambiguous)
+    return Error{Errc::kNotConverged, "relocalise: places within reach align alike (ambiguous)"};
   return Error{Errc::kNotConverged, "relocalise: no seed within reach aligned to the map"};
 }
 
