@@ -11,6 +11,7 @@
 #include "alloc_counter.hpp"
 #include "msgraphs/core/collab/alignment_search.hpp"
 #include "msgraphs/core/collab/free_space_codec.hpp"
+#include "msgraphs/core/collab/free_space_conflict.hpp"
 #include "msgraphs/core/collab/merge_rule.hpp"
 #include "plan_building.hpp"
 
@@ -267,6 +268,79 @@ TEST(MergeRule, AMapThatContradictsItsOwnFreeSpaceMergesNothing) {
   const MergeDecision back = Decide(b, a, search);
   EXPECT_EQ(back.verdict, MergeVerdict::kSelfContradicted) << ToString(back.verdict);
   EXPECT_GT(back.self_conflict_b_m, config.UndoLimit(self));
+}
+
+// Robot y saw a 12 x 10 m hall all free (its border walls occupied); robot x's wall of 6 m,
+// laid by the transform across y's free space at y = 5. Cells are 0.2 m.
+struct WallAcrossFree {
+  FreeSpaceSummary y, x;
+  WallIndex walls_y, walls_x;
+  DistilledGraph graph_y, graph_x;
+
+  WallAcrossFree() {
+    FreeSpaceSummaryConfig fc;
+    fc.max_cells = 1 << 16;
+    EXPECT_TRUE(y.Init(fc));
+    EXPECT_TRUE(x.Init(fc));
+    EXPECT_TRUE(y.Reset({-1, -1}, 0.2f, 70, 60));
+    for (int r = 0; r < 60; ++r)
+      for (int c = 0; c < 70; ++c)
+        y.set(static_cast<std::size_t>(r * 70 + c),
+              r < 5 || r >= 55 || c < 5 || c >= 65 ? SummaryCell::kOccupied : SummaryCell::kFree);
+    y.ComputeClearance();
+    graph_y.Init(8, 2);
+    EXPECT_TRUE(walls_y.Init(8));
+    walls_y.Build(graph_y.walls.span(), 0.5);
+    graph_x.Init(8, 2);
+    EXPECT_TRUE(walls_x.Init(8));
+  }
+  void AddWallX() {
+    DistilledWall w;
+    w.id = static_cast<std::uint32_t>(graph_x.walls.size());
+    w.normal = Eigen::Vector3d(0, 1, 0);
+    w.d = -5;
+    w.a = {3, 5};
+    w.b = {9, 5};
+    w.covariance = Eigen::Matrix3d::Identity() * 1e-4;
+    ASSERT_TRUE(graph_x.walls.try_push_back(w));
+    walls_x.Build(graph_x.walls.span(), 0.5);
+  }
+  // x's own summary: its wall's cells occupied between from_m and to_m along it, the rest unknown.
+  void SeenByX(std::initializer_list<std::pair<double, double>> stretches) {
+    ASSERT_TRUE(x.Reset({-1, -1}, 0.2f, 70, 60));
+    for (const auto& [from_m, to_m] : stretches)
+      for (double s = from_m; s <= to_m + 1e-9; s += 0.1) {
+        const int c = static_cast<int>((s + 1) / 0.2), r = static_cast<int>((5.0 + 1) / 0.2);
+        x.set(static_cast<std::size_t>(r * 70 + c), SummaryCell::kOccupied);
+      }
+    x.ComputeClearance();
+  }
+};
+
+TEST(FreeSpaceConflict, AWallCountsWhereItsRobotSawItOnceForEachFace) {
+  const FreeSpaceConflictConfig c;
+  const PlanarTransform identity{};
+  WallAcrossFree f;
+  f.AddWallX();
+  // x saw its wall along its whole length: all but the extent tolerance at either end counts.
+  f.SeenByX({{3, 9}});
+  const double inner_m = 6 - 2 * c.extent_tolerance_m;
+  EXPECT_NEAR(ConflictOf(f.walls_x, f.x, identity, f.walls_y, f.y, c).walls_in_free_m, inner_m, 0.15);
+  // x saw only the jambs of a 4 m opening (its extent spans it, as an extent unions every
+  // sighting of the plane): x claims no wall in the opening's middle, beyond
+  // door_wall_distance_m of what it saw. The jambs' stretches are under min_stretch_m.
+  f.SeenByX({{3, 4}, {8, 9}});
+  EXPECT_LT(ConflictOf(f.walls_x, f.x, identity, f.walls_y, f.y, c).walls_in_free_m, 0.05);
+  // Laid on itself (merge rule 6) the same wall counts whole: the map is one robot's.
+  EXPECT_NEAR(ConflictOf(f.walls_x, f.x, identity, f.walls_y, f.y, c, nullptr, false).walls_in_free_m, inner_m,
+              0.15);
+  // The same face held twice by x (two landmarks of one plane) counts once between robots,
+  // twice against itself (a face held twice where the robot saw through is the slip rule 6 is for).
+  f.SeenByX({{3, 9}});
+  f.AddWallX();
+  EXPECT_NEAR(ConflictOf(f.walls_x, f.x, identity, f.walls_y, f.y, c).walls_in_free_m, inner_m, 0.15);
+  EXPECT_NEAR(ConflictOf(f.walls_x, f.x, identity, f.walls_y, f.y, c, nullptr, false).walls_in_free_m,
+              2 * inner_m, 0.3);
 }
 
 TEST(MergeRule, DecidingAllocatesNothing) {

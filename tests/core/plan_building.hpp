@@ -94,7 +94,10 @@ struct PlanBuilding {
         core::SummaryCell state = core::SummaryCell::kUnknown;
         for (const Seen& v : seen) {
           const PlanSpace& r = spaces[static_cast<std::size_t>(v.space)];
-          if (p.x() < v.x0 || p.x() > v.x1) continue;  // beyond the part seen
+          // Beyond the part seen; a whole end's wall band counts (its face was seen).
+          const double band = half + 0.5 * cell_m;
+          const double lo_x = v.x0 > r.x0 ? v.x0 : r.x0 - band, hi_x = v.x1 < r.x1 ? v.x1 : r.x1 + band;
+          if (p.x() < lo_x || p.x() > hi_x) continue;
           // Inside by more than half a cell: free; within half a cell of a face (the wall
           // behind it): occupied.
           const double inside = std::min({p.x() - r.x0, r.x1 - p.x(), p.y() - r.y0, r.y1 - p.y()});
@@ -105,6 +108,25 @@ struct PlanBuilding {
           if (inside > -(half + 0.5 * cell_m)) state = core::SummaryCell::kOccupied;
         }
         out.set(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x), state);
+      }
+    }
+    // Every face seen leaves its cells occupied, as the returns on it would in a robot's grid
+    // (cell centres alone miss a thin band that runs across a rotated grid).
+    for (const Seen& v : seen) {
+      const PlanSpace& r = spaces[static_cast<std::size_t>(v.space)];
+      const double x0 = std::max(r.x0, v.x0), x1 = std::min(r.x1, v.x1);
+      const Eigen::Vector2d c[4] = {{x0, r.y0}, {x1, r.y0}, {x1, r.y1}, {x0, r.y1}};
+      for (int k = 0; k < 4; ++k) {
+        if ((k == 1 && x1 < r.x1) || (k == 3 && x0 > r.x0)) continue;  // a cut end
+        const Eigen::Vector2d a = T_map_world * c[k], b = T_map_world * c[(k + 1) % 4];
+        const int steps = static_cast<int>((b - a).norm() / (0.25 * cell_m)) + 1;
+        for (int i = 0; i <= steps; ++i) {
+          const Eigen::Vector2d q = a + (b - a) * (static_cast<double>(i) / steps);
+          const int cx = static_cast<int>((q.x() - lo.x()) / cell_m), cy = static_cast<int>((q.y() - lo.y()) / cell_m);
+          if (cx < 0 || cy < 0 || cx >= w || cy >= h) continue;
+          out.set(static_cast<std::size_t>(cy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(cx),
+                  core::SummaryCell::kOccupied);
+        }
       }
     }
     for (const PlanDoor& d : doors) {

@@ -2,6 +2,7 @@
 #include "msgraphs/core/collab/free_space_conflict.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace msgraphs::core {
@@ -55,6 +56,58 @@ bool SameDoorway(const FreeSpaceSummary& y, const Eigen::Vector2d& a, const Eige
   return false;
 }
 
+// Robot x saw its own wall near `p_x` (x's frame): a cell of x's summary within `reach_m` of the
+// sample, along the wall and across it, is occupied. A distilled wall's extent is the union of
+// what was associated to its plane, so it spans every doorway between two sightings of the
+// wall, doorways x never saw into; there x claims no wall, and another robot that walked
+// through the door must not be refuted by it. Along the wall too, so that a gap of a cell or
+// two in what a grazing view left occupied still counts as wall: only a doorway's middle, more
+// than `reach_m` from both jambs, is unseen. An empty summary (none yet) says nothing either way.
+bool SeenSolid(const FreeSpaceSummary& x, const Eigen::Vector2d& p_x, const Eigen::Vector2d& n_x, double reach_m,
+               double step_m) {
+  if (x.empty()) return true;
+  const Eigen::Vector2d u_x(-n_x.y(), n_x.x());
+  for (double along = -reach_m; along <= reach_m + 1e-9; along += step_m) {
+    for (double across = -reach_m; across <= reach_m + 1e-9; across += step_m) {
+      if (x.state_at(p_x + along * u_x + across * n_x) == SummaryCell::kOccupied) return true;
+    }
+  }
+  return false;
+}
+
+// The stretches counted so far for one pair of maps, y's frame: one face of one wall counts
+// once. A robot's map may hold a wall's face twice (two landmarks of one plane that never
+// merged, the same extent), and one doorway then counted two or three times over (benchmark
+// m037: three copies of one 1.1 m stretch). The other face of a thin wall is another
+// observation, as it is in the agreement, and counts.
+class CountedStretches {
+ public:
+  /// The part of a-b (y's frame; `n` its wall's facing) not yet counted, in metres, and records it.
+  double Add(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& n, double line_m) {
+    const double length = (b - a).norm();
+    if (length <= 0) return 0;
+    const Eigen::Vector2d u = (b - a) / length, across(-u.y(), u.x());
+    double covered = 0;
+    for (std::size_t i = 0; i < count_; ++i) {
+      const Stretch& s = stretches_[i];
+      if (s.n.dot(n) < kSameFacing) continue;
+      if (std::fabs(across.dot(s.a - a)) > line_m || std::fabs(across.dot(s.b - a)) > line_m) continue;
+      const double s0 = std::min(u.dot(s.a - a), u.dot(s.b - a)), s1 = std::max(u.dot(s.a - a), u.dot(s.b - a));
+      covered += std::max(0.0, std::min(s1, length) - std::max(s0, 0.0));
+    }
+    if (count_ < stretches_.size()) stretches_[count_++] = {a, b, n};
+    return std::max(0.0, length - covered);
+  }
+
+ private:
+  static constexpr double kSameFacing = 0.985;  // cos 10 degrees
+  struct Stretch {
+    Eigen::Vector2d a, b, n;
+  };
+  std::array<Stretch, 256> stretches_{};
+  std::size_t count_ = 0;
+};
+
 }  // namespace
 
 Status FreeSpaceConflictConfig::Validate() const {
@@ -70,10 +123,11 @@ Status FreeSpaceConflictConfig::Validate() const {
 FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& summary_x,
                              const PlanarTransform& T_y_x, const WallIndex& walls_y,
                              const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& c,
-                             ConflictVisitor* visitor) {
+                             ConflictVisitor* visitor, bool between_robots) {
   FreeSpaceConflict out;
   if (summary_y.empty()) return out;
   const double step = c.sample_step_m;
+  CountedStretches counted;
   for (const AlignWall& w : walls_x.walls()) {
     const double inner = w.length_m - 2 * c.extent_tolerance_m;
     if (inner <= 0) continue;
@@ -89,17 +143,26 @@ FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& s
     const auto min_run = static_cast<int>(std::ceil(c.min_stretch_m / (inner / n)));
     auto close_run = [&](int end) {
       if (run >= min_run) {
-        out.walls_in_free_m += inner * run / n;
-        if (visitor != nullptr)
-          visitor->Counted(ConflictKind::kWallInFree, a + (b - a) * (static_cast<double>(end - run) / n),
-                           a + (b - a) * (static_cast<double>(end) / n), inner * run / n);
+        const Eigen::Vector2d from = a + (b - a) * (static_cast<double>(end - run) / n);
+        const Eigen::Vector2d to = a + (b - a) * (static_cast<double>(end) / n);
+        // Two landmarks of one face lie within the plane association's gate (a few cm).
+        const double fresh = between_robots ? counted.Add(from, to, n_y, 0.5 * c.sample_step_m)
+                                            : inner * run / n;
+        if (fresh > 0) {
+          out.walls_in_free_m += fresh;
+          if (visitor != nullptr) visitor->Counted(ConflictKind::kWallInFree, from, to, fresh);
+        }
       }
       run = 0;
     };
+    const Eigen::Vector2d a_x = w.a + c.extent_tolerance_m * dir;
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d p = a + (b - a) * ((i + 0.5) / n);
+      const Eigen::Vector2d p_x = a_x + dir * (inner * (i + 0.5) / n);
       const bool in_free = static_cast<double>(summary_y.clearance_m(p)) >= c.clearance_m &&
-                           !summary_y.NearOpening(p, c.opening_margin_m) && !InDoorwayOf(walls_y, a, b, p, n_y, c);
+                           !summary_y.NearOpening(p, c.opening_margin_m) && !InDoorwayOf(walls_y, a, b, p, n_y, c) &&
+                           (!between_robots || SeenSolid(summary_x, p_x, w.n, c.door_wall_distance_m,
+                                                    0.5 * static_cast<double>(summary_x.cell_m())));
       if (in_free)
         ++run;
       else

@@ -68,7 +68,7 @@ bool SelfConsistent(const WallIndex& walls, const FreeSpaceSummary& free, const 
   h = search.Evaluate(walls, walls, identity);
   // Laid on itself, a map's walls meet its own free space in one direction only (the walls of
   // one map in the free space of the same map): conflict_b_in_a carries it all.
-  h.conflict_b_in_a = ConflictOf(walls, free, identity, walls, free, c.conflict);
+  h.conflict_b_in_a = ConflictOf(walls, free, identity, walls, free, c.conflict, nullptr, false);
   h.conflict_a_in_b = FreeSpaceConflict{};
   h.conflict_known = true;
   return StillStanding(h, c);

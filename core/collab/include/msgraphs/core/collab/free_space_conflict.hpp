@@ -6,8 +6,11 @@
 //   in the doorways between two pieces of one of y's walls that x's wall spans (a wall over a
 //   doorway is its lintel, seen by one robot and not the other), and within `extent_tolerance_m` of the wall's ends (an
 //   extent grows with every point associated to the plane and overshoots now and then; a wrong
-//   transform lays whole walls across free space, not their last half metre); and only
-//   stretches of at least `min_stretch_m`.
+//   transform lays whole walls across free space, not their last half metre); only where x
+//   saw its wall (x's own summary occupied within `door_wall_distance_m` of the sample: an
+//   extent spans the doorways between two sightings of the wall, doorways x never saw into);
+//   only stretches of at least `min_stretch_m`; and each place once (a wall held twice, or
+//   both faces of a thin wall, lies on the same stretch of y's free space).
 // - An opening on a solid wall: samples of x's openings that fall on cells y saw occupied next
 //   to one of y's walls, away from y's own openings; counted when they cover at least
 //   `door_solid_share` of the opening (a correct transform leaves the jambs, a fraction of it,
@@ -70,10 +73,14 @@ class ConflictVisitor {
 };
 
 /// Robot x's walls and openings (x's frame), laid into robot y's frame by T_y_x, against y's
-/// summary and walls.
+/// summary and walls. `between_robots` (false for a map laid on itself, merge rule 6): x's walls
+/// count only where x's summary saw them, and one face of a wall once. A map against itself
+/// counts every stretch: there the wall and the free space are one robot's, and a face held
+/// twice where that robot saw through is the slip the check is for (benchmark m023: deduplicated,
+/// a slipped map passed the check and merged a peer half turned).
 FreeSpaceConflict ConflictOf(const WallIndex& walls_x, const FreeSpaceSummary& summary_x,
                              const PlanarTransform& T_y_x, const WallIndex& walls_y,
                              const FreeSpaceSummary& summary_y, const FreeSpaceConflictConfig& config,
-                             ConflictVisitor* visitor = nullptr);
+                             ConflictVisitor* visitor = nullptr, bool between_robots = true);
 
 }  // namespace msgraphs::core
