@@ -2,7 +2,7 @@
 # The building benchmark (docs/results.md, "The building benchmark"): installs what is missing,
 # builds (host release), then runs tools/eval/benchmark.py: missions in generated buildings,
 # every one through the full algorithm and the keyframe baseline, and writes the distributions
-# into docs/results.md. 41 minutes on 2 cores for the 40 missions (measured at 6eb0bce); --ci runs the 5-mission
+# into docs/results.md. 56 minutes on 2 cores for the 40 missions (measured at 017aced); --ci runs the 5-mission
 # subset CI runs (a few minutes).
 #
 #   scripts/benchmark.sh [--ci] [--missions N] [--work out/benchmark] [--results docs/results.md]
