@@ -15,6 +15,12 @@
 namespace msgraphs::core {
 namespace {
 
+// Two poses farther apart than a seed's neighbourhood: different places, not one answer.
+bool Apart(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double apart_m, double apart_rad) {
+  const Eigen::Isometry3d d = a.inverse() * b;
+  return d.translation().head<2>().norm() > apart_m || Eigen::AngleAxisd(d.linear()).angle() > apart_rad;
+}
+
 // The few best-scored seeds, sorted best first and apart: a seed next to a better one would
 // only converge to the same answer (insertion into a handful, no allocation).
 class SeedRanking {
@@ -31,10 +37,7 @@ class SeedRanking {
 
   void Offer(const Eigen::Isometry3d& seed, double score) {
     for (std::size_t j = 0; j < count_; ++j) {
-      const Eigen::Isometry3d d = ranked_[j].seed.inverse() * seed;
-      if (d.translation().head<2>().norm() > apart_m_ ||
-          Eigen::AngleAxisd(d.linear()).angle() > apart_rad_)
-        continue;
+      if (Apart(ranked_[j].seed, seed, apart_m_, apart_rad_)) continue;
       if (ranked_[j].score >= score) return;  // a better neighbour holds the place
       for (std::size_t m = j + 1; m < count_; ++m) ranked_[m - 1] = ranked_[m];
       --count_;
@@ -138,18 +141,20 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
   Relocalisation best;
   const double apart_m = 2 * search.step_m + 1e-6, apart_rad = 2 * search.yaw_step_rad + 1e-6;
   // The best few seeds registered by VGICP; the lowest fitness within the scan-matching
-  // thresholds wins. With `unique`, it wins only if no other place passes too: fitness does
-  // not tell a corridor's look-alike stretches apart (a scan into space the map saw from afar
-  // fits worse than one laid back onto the mapped corridor), so off the predicted path two
-  // places that both align are an ambiguity, not an answer (the caller then resumes on the
-  // motion the robot had).
+  // thresholds wins, and only if no other place passes too: fitness does not tell a
+  // corridor's look-alike stretches apart (a scan into space the map saw from afar fits worse
+  // than one laid back onto the mapped corridor), so two places that both align are an
+  // ambiguity, not an answer (on the segment the search goes on within reach; the caller then
+  // resumes on the motion the robot had). The segment spans metres of corridor too: under
+  // load a node kept down 6 s took the stop point over the robot's place 6 m on.
   bool ambiguous = false;
-  const auto register_best = [&](const SeedRanking& ranking, bool unique) {
+  const auto register_best = [&](const SeedRanking& ranking) {
     bool found = false;
     double best_fitness = config_.scan_match_max_fitness_m2;
     const double min_overlap = config_.scan_match_min_overlap * static_cast<double>(down_.size());
     std::array<Eigen::Isometry3d, 8> passed;
     std::size_t passed_count = 0;
+    Eigen::Isometry3d T_last_best = Eigen::Isometry3d::Identity();
     for (std::size_t k = 0; k < ranking.size(); ++k) {
       auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_,
                                  local_points_.span(), local_tree_, ranking.seed(k),
@@ -171,15 +176,13 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
       if (!(result->fitness < best_fitness)) continue;
       best_fitness = result->fitness;
       best.fitness_m2 = result->fitness;
-      best.T_odom_base = last_odometry_ * result->T_target_source;
+      T_last_best = result->T_target_source;
+      best.T_odom_base = last_odometry_ * T_last_best;
       found = true;
     }
-    if (found && unique) {
-      const Eigen::Isometry3d T_last_best = last_odometry_.inverse() * best.T_odom_base;
+    if (found) {
       for (std::size_t k = 0; k < passed_count; ++k) {
-        const Eigen::Isometry3d d = T_last_best.inverse() * passed[k];
-        if (d.translation().head<2>().norm() > apart_m ||
-            Eigen::AngleAxisd(d.linear()).angle() > apart_rad) {
+        if (Apart(T_last_best, passed[k], apart_m, apart_rad)) {
           ambiguous = true;
           return false;
         }
@@ -214,10 +217,11 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
         }
       }
     }
-    if (register_best(ranking, false)) return best;
+    if (register_best(ranking)) return best;
   }
   if (search.reach_m <= 0) {
     if (!have_map) return Error{Errc::kDegenerate, "relocalise: no map near the search"};
+    if (ambiguous) return Error{Errc::kNotConverged, "relocalise: places on the segment align alike (ambiguous)"};
     return Error{Errc::kNotConverged, "relocalise: no seed aligned to the local map"};
   }
 
@@ -244,7 +248,7 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
       }
     }
   }
-  if (register_best(ranking, true)) return best;
+  if (register_best(ranking)) return best;
   if (ambiguous)
     return Error{Errc::kNotConverged, "relocalise: places within reach align alike (ambiguous)"};
   return Error{Errc::kNotConverged, "relocalise: no seed within reach aligned to the map"};

@@ -284,8 +284,8 @@ class LocalMapper {
   /// registered by VGICP, and the lowest fitness within the scan-matching thresholds (fitness,
   /// overlap) wins. Changes nothing in the map: the caller maps its new odometry frame
   /// with the answer (T_odom_base * T_new_end^-1) and goes on with AddOdometry and AddScan.
-  /// Off the segment (the search within reach) the answer must also be unique: two places
-  /// apart by more than two seed steps or two heading steps that both pass are an ambiguity.
+  /// The answer must also be unique: two places apart by more than two seed steps or two
+  /// heading steps that both pass are an ambiguity (on the segment, the search goes on within reach).
   /// kNotFound without a keyframe; kNotConverged when no seed passes, or passes ambiguously.
   Expected<Relocalisation> Relocalise(const LidarScanView& scan,
                                       const Eigen::Isometry3d& T_new_start,
