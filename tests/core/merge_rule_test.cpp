@@ -228,6 +228,8 @@ TEST(MergeRule, ATruthRefutedByALittleStillBlocksAMuchWeakerLeader) {
   ASSERT_GT(truth.conflict_m(), config.RefuteLimit(truth)) << "the truth is refuted";
   ASSERT_LT(truth.agreement.constraint_m, config.margin_ratio * half_turn.agreement.constraint_m + config.margin_m)
       << "the weakest direction alone would not have blocked it";
+  ASSERT_GE(truth.agreement.constraint_m, half_turn.agreement.constraint_m + config.margin_m)
+      << "stronger in its weakest direction by the absolute margin";
   const MergeDecision d = DecideMerge(in, search, config, nullptr);
   EXPECT_EQ(d.verdict, MergeVerdict::kContradicted) << ToString(d.verdict);
   ASSERT_TRUE(d.has_best_refuted);

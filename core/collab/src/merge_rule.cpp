@@ -149,9 +149,12 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     // Rule 5: the refuted hypotheses are those before the leader (sorted by agreement). One is
     // stronger evidence in every respect when it beats the leader by the margin both in
     // agreement and in its weakest direction, or when, charged with its own conflict (agreement
-    // minus conflict), it still beats the leader by the margin in agreement and is no weaker in
-    // its weakest direction (a corridor's slide, strong along the corridor only, counts in
-    // neither way). Charging
+    // minus conflict), it still beats the leader by the margin in agreement and beats it in its
+    // weakest direction by the absolute margin, not the ratio (a corridor's slide, strong along
+    // the corridor only, counts in neither way: across the corridor it rests on the same walls as
+    // the leader, so the two weakest directions tie, and a tie must not be decided by rounding:
+    // an aarch64 build summed 9.7 m a hair above the x86 one and called the slide stronger).
+    // Charging
     // the conflict keeps a correctly refuted alias out (a pair sharing one room: a corridor
     // slide with 59.5 m of agreement and 23.1 m of conflict against the truth's 26.4 m); not
     // asking the weakest direction to beat the leader's by the margin too lets in a truth that
@@ -174,7 +177,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
                                  h.agreement.constraint_m >= c.margin_ratio * L.agreement.constraint_m + c.margin_m;
       const bool stronger_net =
           h.agreement.agreement_m - h.conflict_m() >= c.margin_ratio * L.agreement.agreement_m + c.margin_m &&
-          h.agreement.constraint_m >= L.agreement.constraint_m;
+          h.agreement.constraint_m >= L.agreement.constraint_m + c.margin_m;
       if (!stronger_both && !stronger_net) continue;
       out.verdict = MergeVerdict::kContradicted;
       out.best_refuted = h;

@@ -22,11 +22,11 @@
 //    rival too. So are the leader's slides along either principal direction of its agreement that
 //    stand (a structure repeated along it: racks at a pitch, a hall's bays).
 // 5. No refuted hypothesis may beat the leader by the margin, in agreement and in its weakest
-//    direction both, nor by the margin in agreement net of its own conflict while no weaker in
-//    its weakest direction (kContradicted): when the strongest evidence two maps have in common is
-//    contradicted, the likeliest explanation is an error in the free space or the maps (the
-//    true transform refuted by an artefact), not that a much weaker alternative is true; and a
-//    weaker alternative is what a repeated structure (a mirrored wing) offers.
+//    direction both, nor by the margin in agreement net of its own conflict while stronger in
+//    its weakest direction by `margin_m` (kContradicted): when the strongest evidence two maps
+//    have in common is contradicted, the likeliest explanation is an error in the free space or
+//    the maps (the true transform refuted by an artefact), not that a much weaker alternative is
+//    true; and a weaker alternative is what a repeated structure (a mirrored wing) offers.
 // 6. Neither map may contradict its own free space: its walls, laid on themselves by the
 //    identity (the one transform known to be true), must stand under the undo limit
 //    (kSelfContradicted). A robot whose map slipped (an encoder slip its scan matching did not
