@@ -421,6 +421,70 @@ TEST(CollaborativeGraph, RecoversAnotherRobotsSE3OriginFromRoomsAndWalls) {
   EXPECT_FALSE(g.Init({}, 0));  // robot ids start at 1
 }
 
+// A corridor's centre along its length is the centroid of the stretch its robot saw: two
+// robots that saw different stretches place it 4 m apart along it (benchmark m011: a tie in
+// all directions slid a merged origin 7.6 m). One shared room places robot 2; the corridor
+// pair, tied across its axis only, must not pull it along, and a shift across the corridor
+// is still held.
+TEST(CollaborativeGraph, ACorridorIsTiedAcrossItsAxisOnly) {
+  const Eigen::Isometry3d truth = Planar(7.0, -3.0, 1.1);
+  DistilledGraph a, b;
+  a.Init(16, 4);
+  b.Init(16, 4);
+  AddRoom(a, 0, 0, Planar(2, 3, 0.3), 1);
+  AddRoom(b, 10, 5, truth.inverse() * Planar(2, 3, 0.3), 1);
+  const double yaw_a = 0.3;  // the corridor's x axis (across it) in robot 1's frame
+  const Eigen::Vector2d across(std::cos(yaw_a), std::sin(yaw_a)), along(-std::sin(yaw_a), std::cos(yaw_a));
+  auto corridor = [&](std::uint32_t id, const Eigen::Vector2d& centre_in_a) {
+    DistilledRoom r;
+    r.id = id;
+    r.version = 1;
+    r.shape = RoomShape::kCorridor;
+    r.size_x_m = 2.0;
+    r.centre = (truth.inverse() * Eigen::Vector3d(centre_in_a.x(), centre_in_a.y(), 0)).head<2>();
+    r.yaw_rad = yaw_a - 1.1;
+    return r;
+  };
+  DistilledRoom corridor_a = corridor(1, Eigen::Vector2d(10, 2));
+  corridor_a.centre = Eigen::Vector2d(10, 2);
+  corridor_a.yaw_rad = yaw_a;
+  const Eigen::Isometry3d initial = truth * Planar(0.3, -0.2, 0.05);
+  for (const double along_m : {4.0, -6.0}) {
+    CollaborativeGraph g;
+    ASSERT_TRUE(g.Init({}, 1));
+    ASSERT_TRUE(g.SetInitial(2, initial));
+    auto ra = g.AddRoom(1, a.rooms[0], 0.0);
+    auto rb = g.AddRoom(2, b.rooms[0], 0.0);
+    ASSERT_TRUE(ra && rb);
+    ASSERT_TRUE(g.AddRoomRoom(*ra, *rb));
+    auto ca = g.AddRoom(1, corridor_a, 0.0);
+    auto cb = g.AddRoom(2, corridor(6, Eigen::Vector2d(10, 2) + along_m * along), 0.0);
+    ASSERT_TRUE(ca && cb);
+    ASSERT_TRUE(g.AddRoomRoom(*ca, *cb));
+    ASSERT_TRUE(g.Solve());
+    const Eigen::Isometry3d e = truth.inverse() * g.T_self_robot(2);
+    EXPECT_LT(e.translation().norm(), 1e-3) << along_m << " m along";
+    EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 1e-4) << along_m << " m along";
+    // Each corridor node stays where its own robot put it along the corridor.
+    EXPECT_NEAR(along.dot((g.room_centre(*cb) - g.room_centre(*ca)).head<2>()), along_m, 1e-2);
+  }
+  // 0.5 m across the corridor is a contradiction the solve must settle, not ignore: the two
+  // corridor nodes meet across it (the tie is 1 cm, each robot's room and corridor 7 cm).
+  CollaborativeGraph g;
+  ASSERT_TRUE(g.Init({}, 1));
+  ASSERT_TRUE(g.SetInitial(2, initial));
+  auto ra = g.AddRoom(1, a.rooms[0], 0.0);
+  auto rb = g.AddRoom(2, b.rooms[0], 0.0);
+  auto ca = g.AddRoom(1, corridor_a, 0.0);
+  auto cb = g.AddRoom(2, corridor(6, Eigen::Vector2d(10, 2) + 0.5 * across + 3.0 * along), 0.0);
+  ASSERT_TRUE(ra && rb && ca && cb);
+  ASSERT_TRUE(g.AddRoomRoom(*ra, *rb));
+  ASSERT_TRUE(g.AddRoomRoom(*ca, *cb));
+  ASSERT_TRUE(g.Solve());
+  EXPECT_LT(std::fabs(across.dot((g.room_centre(*cb) - g.room_centre(*ca)).head<2>())), 0.05);
+  EXPECT_GT((g.T_self_robot(2).translation() - truth.translation()).norm(), 0.05) << "robot 2 moved";
+}
+
 TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
   SGraph graph;
   const SGraphConfig graph_config;

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The collaborative graph of the merged peers (collaborative_graph.hpp): each merged peer's
 // origin starts at its merge (or the previous estimate when that is the same placement); room
-// matches the merge agrees with are tied room to room, with their walls wall to wall, and their
-// fine alignments measure the origin directly; with fewer than two such rooms, the walls the
-// merge lays on each other tie the maps. And the priors that feed it all back into
+// matches the merge agrees with are tied room to room (corridors across their axis only), with
+// their walls wall to wall, and their fine alignments measure the origin directly; with fewer
+// than two such rooms (corridors not counted), the walls the merge lays on each other tie the
+// maps. And the priors that feed it all back into
 // the local S-Graph.
 #include <cmath>
 
@@ -65,7 +66,9 @@ void CollabSession::Impl::Solve() {
       auto na = graph.AddRoom(config.robot, *ra, floor_z_m);
       auto nb = graph.AddRoom(p.robot, *rb, PeerFloor(p));
       if (!na || !nb || !graph.AddRoomRoom(*na, *nb)) continue;
-      ++room_pairs;
+      // A corridor is tied across its axis only: it does not count towards the two rooms that
+      // place a peer without the merge's walls.
+      if (ra->shape != RoomShape::kCorridor && rb->shape != RoomShape::kCorridor) ++room_pairs;
       ++stats.solve_room_pairs;
       if (!config.mode.walls) continue;
       for (std::int32_t wa : ra->walls) {

@@ -53,6 +53,24 @@ struct RoomSame {
   }
 };
 
+// Two nodes of the same corridor: the same line across, the same floor; nothing along. A
+// corridor's centre along its length is the centroid of whatever stretch its robot saw, so
+// two robots' centres differ along it by up to the corridor's length (a 1 cm tie there slid a
+// merged origin 7.6 m along a corridor, benchmark m011). The across axis is the corridor's
+// room-frame x axis (the normal of its wall pair) through its robot's origin.
+struct CorridorSame {
+  double yaw_rad, inv_sigma;
+  template <typename T>
+  bool operator()(const T* q, const T* p_a, const T* p_b, T* r) const {
+    const Eigen::Matrix<T, 3, 1> across =
+        Rotation(q) * Eigen::Matrix<T, 3, 1>(T(std::cos(yaw_rad)), T(std::sin(yaw_rad)), T(0));
+    const Eigen::Matrix<T, 3, 1> e(p_b[0] - p_a[0], p_b[1] - p_a[1], p_b[2] - p_a[2]);
+    r[0] = across.dot(e) * T(inv_sigma);
+    r[1] = e[2] * T(inv_sigma);
+    return true;
+  }
+};
+
 // The two rooms' x axes (each robot's measured yaw through its origin) agree up to quarter
 // turns: sin(4 delta) / 4 is delta near each of them.
 struct RoomYaw {
@@ -149,6 +167,7 @@ struct CollaborativeGraph::Impl {
     std::uint16_t robot = 0;
     std::uint32_t id = 0;
     double yaw_rad = 0;
+    bool corridor = false;
     double p[3] = {0, 0, 0};
   };
   std::vector<Origin> origins;
@@ -315,6 +334,7 @@ Expected<std::uint32_t> CollaborativeGraph::AddRoom(std::uint16_t robot,
   node.robot = robot;
   node.id = room.id;
   node.yaw_rad = room.yaw_rad;
+  node.corridor = room.shape == RoomShape::kCorridor;
   const Eigen::Vector3d centre(room.centre.x(), room.centre.y(), floor_z_m);
   const Eigen::Vector3d p = m.Pose(robot) * centre;
   for (int i = 0; i < 3; ++i) node.p[i] = p[i];
@@ -351,9 +371,17 @@ Status CollaborativeGraph::AddRoomRoom(std::uint32_t a, std::uint32_t b) {
     return Error{Errc::kCapacityExceeded, "collaborative graph: factor store full"};
   Impl::Room& A = m.rooms[a];
   Impl::Room& B = m.rooms[b];
-  m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RoomSame, 3, 3, 3>(
-                                  new RoomSame{1.0 / m.config.room_same_sigma_m}),
-                              m.huber.get(), A.p, B.p);
+  if (A.corridor || B.corridor) {
+    // Either robot's corridor axis will do: the yaw factor below turns them together.
+    const Impl::Room& C = A.corridor ? A : B;
+    m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<CorridorSame, 2, 4, 3, 3>(
+                                    new CorridorSame{C.yaw_rad, 1.0 / m.config.room_same_sigma_m}),
+                                m.huber.get(), m.origins[C.robot].q, A.p, B.p);
+  } else {
+    m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RoomSame, 3, 3, 3>(
+                                    new RoomSame{1.0 / m.config.room_same_sigma_m}),
+                                m.huber.get(), A.p, B.p);
+  }
   if (A.robot != B.robot) {
     m.problem->AddResidualBlock(new ceres::AutoDiffCostFunction<RoomYaw, 1, 4, 4>(new RoomYaw{
                                     A.yaw_rad, B.yaw_rad, 1.0 / m.config.room_yaw_sigma_rad}),

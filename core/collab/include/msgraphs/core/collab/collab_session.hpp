@@ -86,8 +86,12 @@ struct CollabSessionConfig {
   /// moved by more than this (its distilled entry follows every centimetre).
   double descriptor_resend_m = 0.3;
   /// From this many consistent matches on, a new candidate of that peer is checked against the
-  /// merged estimate instead of by fine alignment: no room cloud crosses the radio.
-  std::size_t anchored_matches = 3;
+  /// merged estimate instead of by fine alignment: no room cloud crosses the radio. 0: from the
+  /// merge on (the merge rule has placed the pair from walls and free space; a fine alignment
+  /// would only refine it, and room clouds are half the bytes). Safe only because a corridor is
+  /// tied across its axis alone (collaborative_graph.hpp): with its centroid tied in all
+  /// directions, a pair held by room-to-room factors alone slid 7.6 m along a corridor.
+  std::size_t anchored_matches = 0;
   double anchored_translation_m = 0.5;
   double anchored_rotation_rad = 0.1;
   /// A fine alignment measures the origin directly; its sigma (room clouds carry map error).

@@ -5,8 +5,9 @@
 // - walls and rooms of every robot are nodes in self's map frame, each tied to its robot's
 //   origin by what that robot measured (the distilled estimate, with its covariance);
 // - room-to-room (same centre, orientation equal up to quarter turns) and wall-to-wall (same
-//   plane) factors join the nodes of accepted matches; a fine alignment adds a direct
-//   measurement of an origin;
+//   plane) factors join the nodes of accepted matches; a corridor is tied across its axis and
+//   in height only (its centre along it is wherever its robot's view of it was centred); a
+//   fine alignment adds a direct measurement of an origin;
 // - a weak gravity factor per origin: every robot's map frame is gravity-aligned (its IMU),
 //   which fixes roll and pitch when the matched rooms alone would not.
 // One global solve estimates every origin and refines every wall and room from all robots'
@@ -65,7 +66,8 @@ class CollaborativeGraph {
 
   /// Two wall nodes are the same plane.
   Status AddWallWall(std::uint32_t wall_a, std::uint32_t wall_b);
-  /// Two room nodes are the same room: same centre, frames equal up to quarter turns.
+  /// Two room nodes are the same room: same centre, frames equal up to quarter turns. When
+  /// either is a corridor, the same line across it (and the same height), nothing along it.
   Status AddRoomRoom(std::uint32_t room_a, std::uint32_t room_b);
   /// A direct measurement of robot b's origin (a fine alignment of one room's clouds).
   Status AddOriginMeasurement(std::uint16_t robot_b,
