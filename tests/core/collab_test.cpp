@@ -116,9 +116,18 @@ TEST(DistilledCodec, RoundTripsAndSendsOnlyWhatChanged) {
             Errc::kCapacityExceeded);
 }
 
+// Writes a little-endian u32 into a message at `at`, checked against its size (a raw pointer
+// into a vector that -O3 has inlined made GCC 12 warn of a write past a zero-sized region).
+void PutU32(std::vector<std::uint8_t>& m, std::size_t at, std::uint32_t v) {
+  ASSERT_LE(at + 4, m.size());
+  std::uint8_t bytes[4];
+  WriteU32Le(bytes, v);
+  std::copy(bytes, bytes + 4, m.begin() + static_cast<std::ptrdiff_t>(at));
+}
+
 // Re-seals a tampered message so that the CRC passes and the parser itself must object.
 void Reseal(std::vector<std::uint8_t>& m) {
-  WriteU32Le(&m[m.size() - 4], Crc32(std::span(m.data(), m.size() - 4)));
+  PutU32(m, m.size() - 4, Crc32(std::span(m.data(), m.size() - 4)));
 }
 
 TEST(DistilledCodec, RejectsMalformedInputWithAReason) {
@@ -153,24 +162,24 @@ TEST(DistilledCodec, RejectsMalformedInputWithAReason) {
   const float two = 2.0f;
   std::uint32_t bits;
   std::memcpy(&bits, &two, 4);
-  WriteU32Le(&normal[20 + kDistilledFloorBytes + 8], bits);  // first wall's normal x
+  PutU32(normal, 20 + kDistilledFloorBytes + 8, bits);  // first wall's normal x
   Reseal(normal);
   expect(normal, Errc::kMalformed);
   auto nan = good;
   const float q = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(&bits, &q, 4);
-  WriteU32Le(&nan[20 + kDistilledFloorBytes + 8 + 12], bits);  // first wall's d
+  PutU32(nan, 20 + kDistilledFloorBytes + 8 + 12, bits);  // first wall's d
   Reseal(nan);
   expect(nan, Errc::kMalformed);
   auto covariance = good;
   const float negative = -1.0f;
   std::memcpy(&bits, &negative, 4);
-  WriteU32Le(&covariance[20 + kDistilledFloorBytes + 8 + 16], bits);  // first wall's covariance xx
+  PutU32(covariance, 20 + kDistilledFloorBytes + 8 + 16, bits);  // first wall's covariance xx
   Reseal(covariance);
   expect(covariance, Errc::kMalformed);
   auto unknown_wall = good;
   const std::size_t room0 = 20 + kDistilledFloorBytes + 8 * kDistilledWallBytes;
-  WriteU32Le(&unknown_wall[room0 + 29], 999);  // the first room's first wall id
+  PutU32(unknown_wall, room0 + 29, 999);  // the first room's first wall id
   Reseal(unknown_wall);
   expect(unknown_wall, Errc::kMalformed);
   auto shape = good;
