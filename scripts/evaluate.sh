@@ -67,10 +67,12 @@ tools/eval/budget_check.py --build "$build" "${slam_logs[@]}" \
 
 commit=$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . ':!docs/results.md' || echo "+uncommitted changes")
 minutes=$(( ($(date +%s) - started) / 60 ))
-# The building benchmark's section (scripts/benchmark.sh writes it) is kept as it is.
-bench_block=$(sed -n '/<!-- benchmark begin -->/,/<!-- benchmark end -->/p' "$results" 2>/dev/null || true)
+# The building benchmark's section is kept as it is, to the end of the file: the table that
+# tools/eval/benchmark.py --results writes between its markers and the hand-written analysis
+# around it (only the marked block was kept before, and the analysis was lost).
+bench_section=$(sed -n '/^## The building benchmark/,$p' "$results" 2>/dev/null || true)
 tools/eval/results.py "$work" --commit "$commit" --budget-status $budget_rc --minutes $minutes > "$results.new"
-[[ -z $bench_block ]] || printf '\n## The building benchmark\n\n%s\n' "$bench_block" >> "$results.new"
+[[ -z $bench_section ]] || printf '\n%s\n' "$bench_section" >> "$results.new"
 mv "$results.new" "$results"
 echo
 echo "wrote $results (commit $commit, $minutes min); logs in $work"
