@@ -23,6 +23,7 @@
 #include "msgraphs/runtime/link/ros_publisher.hpp"
 #include "msgraphs/runtime/pipeline/bounded_queue.hpp"
 #include "msgraphs/runtime/pipeline/journal.hpp"
+#include "msgraphs/runtime/pipeline/latency_window.hpp"
 #include "msgraphs/runtime/pipeline/node.hpp"
 #include "msgraphs/runtime/pipeline/replay_clock.hpp"
 
@@ -40,20 +41,6 @@ struct ScanSlot {
 struct OdometrySlot {
   double stamp_s = 0;
   Eigen::Isometry3d T_odom_base = Eigen::Isometry3d::Identity();
-};
-
-/// Latency samples in milliseconds, the newest `capacity` kept (allocated once).
-class LatencyWindow {
- public:
-  explicit LatencyWindow(std::size_t capacity) : values_(capacity) {}
-  void Add(double ms);
-  /// p in [0, 1]; 0 when empty.
-  double Percentile(double p) const;
-  std::uint64_t count() const { return count_; }
-
- private:
-  std::vector<double> values_;
-  std::uint64_t count_ = 0;
 };
 
 /// Counters a thread updates and the supervisor reads; relaxed atomics (statistics only).

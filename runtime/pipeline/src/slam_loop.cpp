@@ -24,20 +24,6 @@ constexpr double kOdometryMargin_s = 0.05;
 
 }  // namespace
 
-void LatencyWindow::Add(double ms) {
-  values_[count_ % values_.size()] = ms;
-  ++count_;
-}
-
-double LatencyWindow::Percentile(double p) const {
-  const std::size_t n = std::min<std::size_t>(count_, values_.size());
-  if (n == 0) return 0;
-  // Called a few times per status line on at most 4096 values: a copy is fine here.
-  std::vector<double> sorted(values_.begin(), values_.begin() + static_cast<std::ptrdiff_t>(n));
-  std::sort(sorted.begin(), sorted.end());
-  return sorted[std::min(n - 1, static_cast<std::size_t>(p * static_cast<double>(n)))];
-}
-
 void Node::Impl::Exchange() {
   if (config.feedback) {
     bool fresh = false;
