@@ -116,6 +116,38 @@ TEST(DistilledCodec, RoundTripsAndSendsOnlyWhatChanged) {
             Errc::kCapacityExceeded);
 }
 
+// distilled_codec.hpp: "Nothing allocates." The receiver's copies are sized by Init; decoding
+// the full message and a delta, applying both, and refusing a corrupted message are counted.
+TEST(DistilledCodec, DecodingApplyingAndRefusingAllocateNothing) {
+  const DistilledGraph g = SampleGraph();
+  std::vector<std::uint8_t> full(4096), delta(4096);
+  const auto n = EncodeDistilled(g, 0, full);
+  const auto d = EncodeDistilled(g, 3, delta);
+  ASSERT_TRUE(n);
+  ASSERT_TRUE(d);
+  DistilledGraph out, copy, delta_only;
+  out.Init(16, 4);
+  copy.Init(16, 4);
+  delta_only.Init(16, 4);
+  std::vector<std::uint8_t> corrupted(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(*n));
+  corrupted[kDistilledHeaderBytes + 3] ^= 0x40u;
+  std::uint64_t allocations = 0;
+  bool decoded = false, applied = false, decoded_delta = false, applied_delta = false, refused = false;
+  {
+    test::AllocationScope scope;
+    decoded = DecodeDistilled(std::span(full.data(), *n), out).has_value();
+    applied = ApplyDistilled(out, copy).has_value();
+    decoded_delta = DecodeDistilled(std::span(delta.data(), *d), delta_only, &copy).has_value();
+    applied_delta = ApplyDistilled(delta_only, copy).has_value();
+    refused = !DecodeDistilled(corrupted, out).has_value();
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_TRUE(decoded && applied && decoded_delta && applied_delta && refused);
+  EXPECT_EQ(copy.walls.size(), 8u);
+  EXPECT_EQ(copy.rooms.size(), 2u);
+}
+
 // Writes a little-endian u32 into a message at `at`, checked against its size (a raw pointer
 // into a vector that -O3 has inlined made GCC 12 warn of a write past a zero-sized region).
 void PutU32(std::vector<std::uint8_t>& m, std::size_t at, std::uint32_t v) {
@@ -591,6 +623,64 @@ std::vector<std::uint8_t> EncodedGraph(const DistilledGraph& g, std::uint32_t si
 }
 
 }  // namespace
+
+// collab_session.hpp: after Init only Ceres allocates, and Receive has no Ceres: a peer's
+// messages (its first graph, which creates the peer, a delta, its descriptor's refusal, a
+// corrupted message, one claiming to be ours, a request for a room we do not have) are decoded
+// into the stores sized at Init. The outbox is the caller's (the node's is Fast DDS, which
+// allocates); this one only counts.
+TEST(CollabSession, ReceivingAPeersMessagesAllocatesNothing) {
+  struct CountingOutbox final : CollabOutbox {
+    std::size_t sends = 0;
+    void Send(CollabMessageType, std::uint16_t, std::span<const std::uint8_t>) override { ++sends; }
+  };
+  CollabSessionConfig config;
+  config.robot = 1;
+  config.max_peers = 2;
+  CollabSession session;
+  ASSERT_TRUE(session.Init(config, SGraphConfig{}, -0.5));
+  DistilledGraph g;
+  g.Init(16, 4);
+  g.robot = 2;
+  AddRoom(g, 0, 0, Planar(2, 3, 0.3), 1);
+  g.version = 1;
+  const auto full = EncodedGraph(g, 0);
+  g.version = 5;
+  g.walls[0].version = 5;
+  g.walls[0].d += 0.1;
+  const auto delta = EncodedGraph(g, 1);
+  auto corrupt = full;
+  corrupt[30] ^= 0x10;
+  g.robot = 1;
+  const auto from_us = EncodedGraph(g, 0);
+  ScanContext sc;
+  const std::vector<Eigen::Vector3f> points = {{1, 0, 1}, {0, 2, 0.5f}, {-1, -1, 2}};
+  ASSERT_TRUE(sc.Build(points, {10, 30, 12.0f, 0.0f}));
+  std::vector<std::uint8_t> descriptor(RoomDescriptorEncodedSize(sc));
+  ASSERT_TRUE(EncodeRoomDescriptor({2, 0, 1}, sc, descriptor));
+  std::vector<std::uint8_t> request(kRoomCloudRequestBytes);
+  ASSERT_TRUE(EncodeRoomCloudRequest({2, 1, 42, 1}, request));
+  CountingOutbox out;
+  std::uint64_t allocations = 0;
+  bool held = false, applied = false, refused = true;
+  {
+    test::AllocationScope scope;
+    held = session.Receive(CollabMessageType::kDistilledGraph, full, out).has_value();
+    applied = session.Receive(CollabMessageType::kDistilledGraph, delta, out).has_value();
+    refused = refused && !session.Receive(CollabMessageType::kDistilledGraph, corrupt, out).has_value();
+    refused = refused && !session.Receive(CollabMessageType::kDistilledGraph, from_us, out).has_value();
+    refused = refused && !session.Receive(CollabMessageType::kRoomDescriptor, descriptor, out).has_value();
+    refused = refused && !session.Receive(CollabMessageType::kRoomCloudRequest, request, out).has_value();
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_TRUE(held && applied && refused);
+  ASSERT_NE(session.peer_graph(2), nullptr);
+  EXPECT_NEAR(session.peer_graph(2)->walls[0].d, g.walls[0].d, 1e-6);
+  EXPECT_EQ(session.stats().malformed, 2u);
+  EXPECT_EQ(session.stats().descriptors_mismatched, 1u);
+  EXPECT_EQ(session.stats().requests_unknown, 1u);
+}
 
 TEST(CollabSession, CountsAndRefusesBadOrHostileMessagesAndKeepsWorking) {
   CollabSessionConfig config;

@@ -93,7 +93,7 @@ CollabSession::Impl::Peer* CollabSession::Impl::FindOrAddPeer(std::uint16_t robo
     if (p.used) continue;
     p.used = true;
     p.robot = robot;
-    p.graph.Init(config.distiller.max_walls, config.distiller.max_rooms);
+    p.graph.Clear();  // sized at Init: a peer joining allocates nothing
     p.graph.robot = robot;
     p.rooms.clear();
     p.pending.clear();

@@ -47,7 +47,16 @@ struct DistilledGraph {
   void Init(std::size_t max_walls, std::size_t max_rooms) {
     walls.Init(max_walls);
     rooms.Init(max_rooms);
+    Clear();
+  }
+  /// Empty, capacities kept: no allocation.
+  void Clear() {
+    walls.clear();
+    rooms.clear();
+    robot = 0;
     has_floor = false;
+    floor_centre.setZero();
+    floor_z_m = 0;
     version = 0;
   }
   const DistilledWall* FindWall(std::uint32_t id) const {

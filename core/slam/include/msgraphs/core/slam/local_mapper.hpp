@@ -2,9 +2,11 @@
 // The local S-Graph front end of one robot: scans and encoder odometry in, the four-layer graph
 // out (docs/s-graph.md).
 //
-// Per scan: odometry at the scan's start and end (OdometryBuffer); a keyframe when the robot
-// moved keyframe_spacing_m or turned keyframe_angle_rad since the last one. Other scans cost
-// two lookups and nothing else.
+// Per scan: odometry at the scan's start and end (OdometryBuffer); with track_scans (the
+// default), the sweep deskewed, thinned to tracking_voxel_m and tracked by VGICP against the
+// local map, seeded by the encoders (a few ms); a keyframe when the robot moved
+// keyframe_spacing_m or turned keyframe_angle_rad since the last one. Without tracking, other
+// scans cost two odometry lookups and nothing else.
 // Per keyframe: deskew with the odometry's motion, range filter, base frame, 0.1 m voxels,
 // normals and covariances; VGICP against the local map (the last keyframes' clouds in the last
 // keyframe's frame) seeded by odometry, checked (convergence, fitness, overlap, divergence from

@@ -11,8 +11,9 @@
 // - horizontal planes (floor and ceiling) are associated too, on the same rule;
 // - a plane seen from its back (the other face of a wall) never associates.
 // Wall extents (endpoints along the wall and heights) are kept here, in the map frame, for
-// room detection. Sized at Init; Associate's own work allocates nothing, but the observations
-// and planes it adds to the S-Graph allocate there (Ceres residual blocks).
+// room detection. Sized at Init. Associate allocates: the observations and planes it adds to
+// the S-Graph are Ceres residual blocks (a keyframe's cost, local_mapper.hpp); its own
+// candidate lists are bounded vectors sized at Init.
 #pragma once
 
 #include <Eigen/Geometry>
