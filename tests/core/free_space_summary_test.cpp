@@ -98,6 +98,61 @@ TEST(FreeSpaceSummary, AWallSeenEdgeOnIsNoOpening) {
   ExpectOnlyTheDoor(Openings(grid));
 }
 
+// The same wall, seen edge-on again and again (a robot standing in a doorway in its line): the
+// grazing rays outnumber the returns off its face, so the fine grid reads its cells "not
+// occupied", but they did return points in the obstacle band, and the summary must not claim
+// them free: a peer's true wall there would count against the true transform (benchmark
+// m010-warehouse), and a robot's own wall against its own map (m034). In front of the wall,
+// where nothing ever returned, the summary stays free.
+TEST(FreeSpaceSummary, AWallSeenEdgeOnIsNotFree) {
+  FreeSpaceGrid grid = Grid();
+  LookFromBothSides(grid);
+  const Eigen::Vector3f in_line(-3, -0.05f, 0.8f);
+  const std::vector<Eigen::Vector3f> grazing(400, Eigen::Vector3f(9.5f, -0.05f, 0.5f));
+  grid.Integrate(in_line, grazing, 0.0f);
+  int x = 0, y = 0;
+  ASSERT_TRUE(grid.ToCell({4.55, -0.05}, x, y));
+  ASSERT_NE(grid.state(x, y), FreeSpaceGrid::Cell::kOccupied);  // the fine grid's reading, as described
+  ASSERT_TRUE(grid.ever_occupied(x, y));
+  FreeSpaceSummary summary;
+  ASSERT_TRUE(summary.Init({}));
+  const DistilledWall wall = TheWall();
+  ASSERT_TRUE(summary.Build(grid, std::span<const DistilledWall>(&wall, 1)));
+  for (double along = 0.5; along < static_cast<double>(kWallTo) - 0.5; along += 0.1) {
+    if (InDoor(static_cast<float>(along)) || InDoor(static_cast<float>(along - 0.3)) ||
+        InDoor(static_cast<float>(along + 0.3)))
+      continue;
+    EXPECT_NE(summary.state_at({along, -0.05}), SummaryCell::kFree) << "at x = " << along;
+  }
+  EXPECT_EQ(summary.state_at({4.5, 1.5}), SummaryCell::kFree);
+}
+
+// A place crossed from two directions was seen through, whatever returned from it once: a
+// person who stood there, or the wall copy a slipped map holds (the evidence merge rule 6
+// needs). It stays free.
+TEST(FreeSpaceSummary, APlaceSeenThroughFromTwoDirectionsIsFreeWhateverReturnedOnce) {
+  FreeSpaceGrid grid = Grid();
+  const Eigen::Vector3f person(0.05f, 0.05f, 1.0f);
+  grid.Integrate({0, -3, 0.8f}, std::span<const Eigen::Vector3f>(&person, 1), 0.0f);
+  int x = 0, y = 0;
+  ASSERT_TRUE(grid.ToCell({0.05, 0.05}, x, y));
+  ASSERT_TRUE(grid.ever_occupied(x, y));
+  // Then the floor behind the place, from the south and from the west.
+  std::vector<Eigen::Vector3f> floor;
+  for (float a = -1.0f; a <= 1.0f; a += 0.02f) {
+    for (float b = 1.0f; b <= 3.0f; b += 0.05f) floor.emplace_back(a, b, 0.0f);
+  }
+  grid.Integrate({0, -3, 0.8f}, floor, 0.0f);
+  for (Eigen::Vector3f& p : floor) p = {p.y(), p.x(), 0.0f};
+  grid.Integrate({-3, 0, 0.8f}, floor, 0.0f);
+  ASSERT_NE(grid.state(x, y), FreeSpaceGrid::Cell::kOccupied);
+  ASSERT_TRUE(grid.clear_across(x, y));
+  FreeSpaceSummary summary;
+  ASSERT_TRUE(summary.Init({}));
+  ASSERT_TRUE(summary.Build(grid, {}));
+  EXPECT_EQ(summary.state_at({0.05, 0.05}), SummaryCell::kFree);
+}
+
 // free_space_summary.hpp: "Build and Decode allocate nothing". The grid, both summaries (Init)
 // and the message buffer are set up first; the first Build and the first Decode are counted.
 TEST(FreeSpaceSummary, BuildAndDecodeAllocateNothing) {

@@ -71,7 +71,8 @@ struct Robot {
 };
 
 // What robot a decides about robot b.
-MergeDecision Decide(Robot& a, Robot& b, AlignmentSearch& search, const PlanarTransform* current = nullptr) {
+MergeDecision Decide(Robot& a, Robot& b, AlignmentSearch& search, const PlanarTransform* current = nullptr,
+                     const MergeRuleConfig& config = {}) {
   search.Search(a.walls, {}, b.walls, {}, {}, false);
   MergeInputs in;
   in.walls_a = &a.walls;
@@ -82,7 +83,8 @@ MergeDecision Decide(Robot& a, Robot& b, AlignmentSearch& search, const PlanarTr
   in.truncated = search.truncated();
   in.sym_a = a.self.hypotheses();
   in.sym_b = b.self.hypotheses();
-  const MergeDecision d = DecideMerge(in, search, MergeRuleConfig{}, current);
+  in.channels = search.channels();
+  const MergeDecision d = DecideMerge(in, search, config, current);
   if (std::getenv("MERGE_DEBUG") != nullptr) {
     const auto show = [](const char* what, const Hypothesis& h) {
       std::printf("  %s: yaw %.3f t (%.2f %.2f) agreement %.2f constraint %.2f conflict b>a %.2f+%.2f a>b %.2f+%.2f votes %u src %u\n",
@@ -151,6 +153,46 @@ TEST(MergeRule, APairSharingOneRoomMerges) {
   const MergeDecision back = Decide(b, a, search);
   ASSERT_EQ(back.verdict, MergeVerdict::kMerge) << ToString(back.verdict);
   ExpectNear(back.leader.T_a_b, Truth(b, a));
+}
+
+// Two robots that share nothing but a corridor, each with a room off it: a's room on the south
+// side at x 5-11, b's on the north at x 25-31, doors placed so that a half turn about x = 18
+// lays b's room, door and the corridor's doors on a's. The half turn fixes both directions
+// (the room) and agrees along 26 m of corridor; the truth agrees along all 50 m of corridor but
+// fixes nothing along it, so no corner pair proposes it (benchmark m023's trap).
+TEST(MergeRule, ACorridorSharedAlongItsLengthIsARivalToAWeakerHalfTurn) {
+  PlanBuilding building;
+  building.spaces.push_back({0, 0, 60, 2.4});
+  building.spaces.push_back({5.075, -5, 10.925, -0.15});  // a's room, space 1
+  building.spaces.push_back({25.075, 2.55, 30.925, 7.4});  // b's room, space 2
+  building.doors.push_back({{6, -0.075}, {7, -0.075}, 0, 1});
+  building.doors.push_back({{29, 2.475}, {30, 2.475}, 0, 2});
+  Robot a(building, {{0, 3, 57}, {1}}, Pose2(4, -2, 0.3));
+  Robot b(building, {{0, 3, 57}, {2}}, Pose2(-12, 9, 2.2));
+  AlignmentSearch search;
+  ASSERT_TRUE(search.Init({}));
+  const PlanarTransform truth = Truth(a, b);
+  // The truth is no hypothesis (it fixes one direction), but it is a channel.
+  search.Search(a.walls, {}, b.walls, {}, {}, false);
+  for (const Hypothesis& h : search.hypotheses()) EXPECT_FALSE(SameTransform(h.T_a_b, truth, 0.5, 0.035));
+  bool channel = false;
+  for (const Hypothesis& h : search.channels()) {
+    channel |= std::fabs(std::remainder(h.T_a_b.yaw_rad - truth.yaw_rad, 2 * kPi)) < 0.01 &&
+               h.agreement.constraint_m < 0.5;
+  }
+  EXPECT_TRUE(channel);
+  // Without one-direction rivals the half turn merges.
+  MergeRuleConfig off;
+  off.one_direction_rivals = false;
+  const MergeDecision wrong = Decide(a, b, search, nullptr, off);
+  ASSERT_EQ(wrong.verdict, MergeVerdict::kMerge) << ToString(wrong.verdict);
+  EXPECT_GT(std::fabs(std::remainder(wrong.leader.T_a_b.yaw_rad - truth.yaw_rad, 2 * kPi)), 3.0);
+  // With them the corridor, out-agreeing the half turn, stands as a rival.
+  const MergeDecision d = Decide(a, b, search);
+  EXPECT_EQ(d.verdict, MergeVerdict::kAmbiguous) << ToString(d.verdict);
+  EXPECT_TRUE(d.rival_one_direction);
+  EXPECT_NEAR(std::remainder(d.rival.T_a_b.yaw_rad - truth.yaw_rad, 2 * kPi), 0.0, 0.01);
+  EXPECT_GE(d.rival.agreement.agreement_m, d.leader.agreement.agreement_m);
 }
 
 TEST(MergeRule, OneRoomAloneMergesWhenItsDoorBreaksTheSymmetry) {

@@ -301,6 +301,11 @@ TEST(Rooms, TheGridWindowFollowsTheRobotThroughABuildingLargerThanIt) {
   ASSERT_TRUE(grid.ToCell(probe, px, py));
   const FreeSpaceGrid::Cell before = grid.state(px, py);
   ASSERT_EQ(before, FreeSpaceGrid::Cell::kFree);
+  // Crossed from both positions, rays 100 degrees apart; the directions move with the window too.
+  const Eigen::Vector2d crossed(3.0, 1.0);
+  int cx = 0, cy = 0;
+  ASSERT_TRUE(grid.ToCell(crossed, cx, cy));
+  ASSERT_TRUE(grid.clear_across(cx, cy));
   {
     test::AllocationScope scope;
     EXPECT_TRUE(grid.Follow(Eigen::Vector2f(13.0f, 2.0f)));
@@ -311,6 +316,8 @@ TEST(Rooms, TheGridWindowFollowsTheRobotThroughABuildingLargerThanIt) {
   EXPECT_FLOAT_EQ(std::fmod(grid.origin_m().x() + 6.0f, 4.0f), 0.0f) << "whole steps of 40 cells";
   ASSERT_TRUE(grid.ToCell(probe, px, py));
   EXPECT_EQ(grid.state(px, py), before);
+  ASSERT_TRUE(grid.ToCell(crossed, cx, cy));
+  EXPECT_TRUE(grid.clear_across(cx, cy));
   EXPECT_FALSE(grid.Follow(Eigen::Vector2f(13.0f, 2.0f))) << "inside now: no move";
   // Down the corridor to the far rooms: the window follows; the near rooms leave it.
   Scan(grid, near.plan, {{11, 6.2}}, true);

@@ -166,6 +166,7 @@ std::vector<ViewExplanation> ExplainViews(const Mission& mission, const Evaluati
       in.free_b = &sb.free_space();
       in.hypotheses = search.hypotheses();
       in.truncated = search.truncated();
+      in.channels = search.channels();
       in.sym_a = symmetries[a];
       in.sym_b = symmetries[b];
       // B's symmetries as A sees them: from the walls A holds of B.

@@ -52,7 +52,8 @@ Status AlignmentSearchConfig::Validate() const {
   if (!(min_wall_length_m > 0) || !(corner_reach_m >= 0) || !(min_corner_angle_rad > 0 && min_corner_angle_rad < 1.5) ||
       !(corner_angle_tolerance_rad > 0) || !(room_size_tolerance_m >= 0) || !(bin_m > 0) || !(bin_rad > 0) ||
       !(keep_constraint_m >= 0) || refine_iterations < 0 || !(same_distance_m > 0) || !(same_angle_rad > 0) ||
-      max_corners < 4 || max_hypotheses < 2 || max_clusters < 16 || !std::has_single_bit(max_clusters)) {
+      max_corners < 4 || max_hypotheses < 2 || max_clusters < 16 || !std::has_single_bit(max_clusters) ||
+      !(min_channel_agreement_m >= 0) || max_channel_families < 16 || !std::has_single_bit(max_channel_families)) {
     return Error{Errc::kInvalidConfig,
                  "alignment search: positive tolerances, a power-of-two cluster table, room for corners"};
   }
@@ -66,6 +67,8 @@ Status AlignmentSearch::Init(const AlignmentSearchConfig& config) {
   corners_b_.Init(config.max_corners);
   clusters_.assign(config.max_clusters, Cluster{});
   hypotheses_.Init(config.max_hypotheses);
+  families_.assign(config.max_channel_families, AlignmentChannelFamily{});
+  channels_.Init(config.max_channels);
   return Ok();
 }
 
@@ -154,6 +157,78 @@ void AlignmentSearch::Keep(const Hypothesis& h) {
   if (worst->agreement.agreement_m < h.agreement.agreement_m) *worst = h;
 }
 
+void AlignmentSearch::Channels(const WallIndex& a, const WallIndex& b) {
+  if (!(config_.min_channel_agreement_m > 0) || channels_.capacity() == 0) return;
+  const std::size_t mask = families_.size() - 1;
+  for (const AlignWall& wa : a.walls()) {
+    if (wa.length_m < config_.min_wall_length_m) continue;
+    // The line's direction taken once (a corridor's two faces are one family): the normal's
+    // angle in [0, pi), the offset across measured along it.
+    const bool flip = wa.angle_rad < 0;
+    const Eigen::Vector2d n = flip ? Eigen::Vector2d(-wa.n) : wa.n;
+    const Eigen::Vector2d u(-n.y(), n.x());
+    const double axis_rad = flip ? wa.angle_rad + kPi : wa.angle_rad;
+    for (const AlignWall& wb : b.walls()) {
+      if (wb.length_m < config_.min_wall_length_m) continue;
+      const double yaw = Wrap(wa.angle_rad - wb.angle_rad);
+      // b's wall on a's line: wa.n . t = wb.d - wa.d (both lines n.p + d = 0).
+      const double across = (flip ? -1.0 : 1.0) * (wb.d - wa.d);
+      const Eigen::Matrix2d R = PlanarTransform{yaw, Eigen::Vector2d::Zero()}.R();
+      const double along = u.dot(0.5 * (wa.a + wa.b) - R * (0.5 * (wb.a + wb.b)));
+      const double weight = std::min(wa.length_m, wb.length_m);
+      const std::uint64_t key = Pack(std::llround(yaw / config_.bin_rad), std::llround(axis_rad / config_.bin_rad),
+                                     std::llround(across / config_.bin_m));
+      bool placed = false;
+      for (std::size_t probe = 0, k = Mix(key) & mask; probe < families_.size(); ++probe, k = (k + 1) & mask) {
+        AlignmentChannelFamily& f = families_[k];
+        if (f.used && f.key != key) continue;
+        if (!f.used) {
+          if (4 * (stats_.channel_families + 1) > 3 * families_.size()) break;
+          f = AlignmentChannelFamily{};
+          f.used = true;
+          f.key = key;
+          f.n = n;
+          ++stats_.channel_families;
+        }
+        f.weight_m += weight;
+        f.cos_sum += weight * std::cos(yaw);
+        f.sin_sum += weight * std::sin(yaw);
+        f.across_sum += weight * across;
+        f.along_sum += weight * along;
+        placed = true;
+        break;
+      }
+      if (!placed) ++stats_.channel_families_dropped;
+    }
+  }
+  for (const AlignmentChannelFamily& f : families_) {
+    if (!f.used || f.weight_m < config_.min_channel_agreement_m) continue;
+    const Eigen::Vector2d u(-f.n.y(), f.n.x());
+    const PlanarTransform T{std::atan2(f.sin_sum, f.cos_sum), (f.across_sum * f.n + f.along_sum * u) / f.weight_m};
+    ++stats_.channels_scored;
+    Hypothesis h = Evaluate(a, b, T);
+    if (h.agreement.agreement_m < config_.min_channel_agreement_m) continue;
+    h.votes = 1;
+    h.sources = kFromChannel;
+    bool same = false;
+    for (Hypothesis& k : channels_) {
+      if (!SameTransform(k.T_a_b, h.T_a_b, config_.same_distance_m, config_.same_angle_rad)) continue;
+      if (h.agreement.agreement_m > k.agreement.agreement_m) k = h;
+      same = true;
+      break;
+    }
+    if (same || channels_.try_push_back(h)) continue;
+    Hypothesis* worst = &channels_[0];
+    for (Hypothesis& k : channels_) {
+      if (k.agreement.agreement_m < worst->agreement.agreement_m) worst = &k;
+    }
+    if (worst->agreement.agreement_m < h.agreement.agreement_m) *worst = h;
+  }
+  std::sort(channels_.begin(), channels_.end(), [](const Hypothesis& x, const Hypothesis& y) {
+    return x.agreement.agreement_m > y.agreement.agreement_m;
+  });
+}
+
 Hypothesis AlignmentSearch::Evaluate(const WallIndex& a, const WallIndex& b, const PlanarTransform& T) const {
   Hypothesis h;
   h.T_a_b = RefineTransform(a, b, T, config_.agreement, config_.refine_iterations);
@@ -166,7 +241,9 @@ std::size_t AlignmentSearch::Search(const WallIndex& a, std::span<const Distille
                                     bool self) {
   stats_ = {};
   hypotheses_.clear();
+  channels_.clear();
   for (Cluster& c : clusters_) c.used = false;
+  for (AlignmentChannelFamily& f : families_) f.used = false;
   Corners(a, corners_a_);
   if (self) {
     corners_b_.clear();
@@ -232,6 +309,7 @@ std::size_t AlignmentSearch::Search(const WallIndex& a, std::span<const Distille
   std::sort(hypotheses_.begin(), hypotheses_.end(), [](const Hypothesis& x, const Hypothesis& y) {
     return x.agreement.agreement_m > y.agreement.agreement_m;
   });
+  if (!self) Channels(a, b);
   return hypotheses_.size();
 }
 

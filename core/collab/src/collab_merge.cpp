@@ -110,6 +110,7 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
     in.truncated = search.truncated();
     in.sym_a = own_symmetries.span();
     in.sym_b = p.symmetries.span();
+    in.channels = search.channels();
     d = DecideMerge(in, search, config.merge, p.merged ? &p.T_merge : nullptr);
   }
   const double same_m = config.search.same_distance_m, same_rad = config.search.same_angle_rad;

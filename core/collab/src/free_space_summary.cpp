@@ -68,6 +68,39 @@ bool FreeSpaceSummary::NearOpening(const Eigen::Vector2d& p, double margin_m) co
   return false;
 }
 
+namespace {
+
+// A fine cell of a wall seen edge-on: it returned points in the obstacle band, the descending
+// rays through it ran one way only (within a sector or two side by side), and the returns line
+// up along those rays (another cell one or two steps along them returned points too): the rays
+// grazed a surface that runs their way. A wall copy that rays crossed, one way but across it,
+// has its returns across the rays instead, and is seen through.
+bool SeenEdgeOn(const FreeSpaceGrid& grid, int x, int y) {
+  if (!grid.ever_occupied(x, y) || grid.clear_across(x, y)) return false;
+  const unsigned mask = grid.clear_directions(x, y);
+  if (mask == 0) return false;  // no descending ray crossed it: not free anyway
+  int sector = 0;
+  while ((mask & (1u << sector)) == 0) ++sector;
+  // The middle of the set sectors: one, or two side by side (the last and the first are side
+  // by side across the half turn).
+  double sectors = sector + 0.5;
+  if (sector == 0 && (mask & (1u << (FreeSpaceGrid::kDirectionSectors - 1))) != 0) {
+    sectors = 0.0;
+  } else if ((mask & (1u << (sector + 1))) != 0) {
+    sectors = sector + 1.0;
+  }
+  constexpr double kPi = 3.14159265358979323846;
+  const double angle = sectors * kPi / FreeSpaceGrid::kDirectionSectors;
+  const double ux = std::cos(angle), uy = std::sin(angle);
+  for (const double step : {1.0, 2.0, -1.0, -2.0}) {
+    const int nx = x + static_cast<int>(std::lround(step * ux)), ny = y + static_cast<int>(std::lround(step * uy));
+    if ((nx != x || ny != y) && grid.ever_occupied(nx, ny)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 Status FreeSpaceSummary::Build(const FreeSpaceGrid& grid, std::span<const DistilledWall> walls) {
   // The bounding box of the known fine cells.
   int x0 = grid.width(), y0 = grid.height(), x1 = -1, y1 = -1;
@@ -114,7 +147,7 @@ Status FreeSpaceSummary::Build(const FreeSpaceGrid& grid, std::span<const Distil
   for (int cy = 0; cy < h; ++cy) {
     for (int cx = 0; cx < w; ++cx) {
       int free = 0;
-      bool occupied = false;
+      bool occupied = false, edge_on = false;
       for (int fy = 0; fy < ratio && !occupied; ++fy) {
         for (int fx = 0; fx < ratio; ++fx) {
           const int gx = (cx0 + cx) * ratio + fx, gy = (cy0 + cy) * ratio + fy;
@@ -122,12 +155,19 @@ Status FreeSpaceSummary::Build(const FreeSpaceGrid& grid, std::span<const Distil
             occupied = true;
             break;
           }
+          edge_on = edge_on || SeenEdgeOn(grid, gx, gy);
           free += grid.clear_below_sensor(gx, gy) ? 1 : 0;
         }
       }
-      const SummaryCell s = occupied          ? SummaryCell::kOccupied
-                            : free >= need_free ? SummaryCell::kFree
-                                                : SummaryCell::kUnknown;
+      // A wall seen edge-on (from a doorway in its line: many grazing rays, few returns, so the
+      // fine grid reads it "not occupied") is not free space: a peer's true wall there would
+      // count against the true transform (benchmark m010-warehouse, 3 m of it), a robot's own
+      // wall against its own map (m034). Unknown, not occupied. A place the rays crossed was
+      // seen through, whatever returned from it once (a person who walked by, the wall copy of
+      // a slipped map: m023, the evidence merge rule 6 needs).
+      const SummaryCell s = occupied                       ? SummaryCell::kOccupied
+                            : free >= need_free && !edge_on ? SummaryCell::kFree
+                                                            : SummaryCell::kUnknown;
       cells_[static_cast<std::size_t>(cy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(cx)] =
           static_cast<std::uint8_t>(s);
     }

@@ -62,6 +62,48 @@ void MeasureConflict(Hypothesis& h, const MergeInputs& in, const FreeSpaceConfli
   h.conflict_known = true;
 }
 
+namespace {
+
+// Rule 3, one direction: the channel `ch` probed along the direction its walls leave free, over
+// the extent of b's walls along it; true with `rival` when a probe agrees at least as much as
+// the leader and stands.
+bool OneDirectionRival(const Hypothesis& ch, const Hypothesis& L, MergeInputs& in, const AlignmentSearch& search,
+                       const MergeRuleConfig& c, Hypothesis& rival) {
+  const AlignmentSearchConfig& sc = search.config();
+  if (SameTransform(ch.T_a_b, L.T_a_b, sc.same_distance_m, sc.same_angle_rad)) return false;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(ch.agreement.information);
+  const Eigen::Vector2d dir = eig.eigenvectors().col(0);  // the weaker direction
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const AlignWall& w : in.walls_b->walls()) {
+    for (const Eigen::Vector2d& p : {w.a, w.b}) {
+      const double s = dir.dot(ch.T_a_b * p);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+  }
+  const double span_m = hi > lo ? hi - lo : 0.0;
+  const double step_m = std::max(2 * sc.agreement.offset_m, span_m / static_cast<double>(std::max<std::size_t>(1, c.max_slide_probes)));
+  for (double s = 0; s <= span_m; s += step_m) {
+    for (const double sign : {1.0, -1.0}) {
+      if (s == 0 && sign < 0) continue;
+      PlanarTransform T = ch.T_a_b;
+      T.t_m += sign * s * dir;
+      if (ScoreAgreement(*in.walls_a, *in.walls_b, T, sc.agreement).agreement_m < L.agreement.agreement_m) continue;
+      Hypothesis h = search.Evaluate(*in.walls_a, *in.walls_b, T);
+      if (h.agreement.agreement_m < L.agreement.agreement_m) continue;
+      if (SameTransform(h.T_a_b, L.T_a_b, sc.same_distance_m, sc.same_angle_rad)) continue;
+      MeasureConflict(h, in, c.conflict);
+      if (h.conflict_m() > c.RefuteLimit(h)) continue;
+      h.sources |= kFromChannel;
+      rival = h;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 bool SelfConsistent(const WallIndex& walls, const FreeSpaceSummary& free, const AlignmentSearch& search,
                     const MergeRuleConfig& c, Hypothesis& h) {
   const PlanarTransform identity{};
@@ -258,6 +300,21 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     // A merge is undone when a rival now beats it by the margin, not merely when one stands.
     out.overturned = keeping && Beats(out.rival, L, c.margin_ratio, c);
     return out;
+  }
+  // Rule 3 in one direction: an alignment that agrees at least as much as the leader, though
+  // along one line only, is a rival the leader cannot beat (benchmark m023: two robots share one
+  // corridor, 84 m along it; a half turn elsewhere agrees along 70 m, 35 m across, and would
+  // merge 26 m off). Measured only where the rule would merge.
+  if (!keeping && c.one_direction_rivals) {
+    for (const Hypothesis& ch : in.channels) {
+      Hypothesis r;
+      if (!OneDirectionRival(ch, L, in, search, c, r)) continue;
+      out.rival = r;
+      out.has_rival = true;
+      out.rival_one_direction = true;
+      out.verdict = MergeVerdict::kAmbiguous;
+      return out;
+    }
   }
   // Rule 6: a new merge (or a move to another transform) needs both maps consistent with their
   // own free space; measured only here, where the rule would merge, as it is rarely needed.

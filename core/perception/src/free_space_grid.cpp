@@ -7,6 +7,9 @@
 #include <cstring>
 
 namespace msgraphs::core {
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
 
 Status FreeSpaceGridConfig::Validate() const {
   if (!(resolution_m >= 0.02f && resolution_m <= 1.0f) || width < 8 || height < 8 || width > 8192 || height > 8192 ||
@@ -24,6 +27,7 @@ Status FreeSpaceGrid::Init(const FreeSpaceGridConfig& config) {
   free_.assign(n, 0);
   occupied_.assign(n, 0);
   clear_low_.assign(n, 0);
+  low_directions_.assign(n, 0);
   outside_ = 0;
   moves_ = 0;
   origin0_m_ = config.origin_m;
@@ -35,6 +39,7 @@ void FreeSpaceGrid::Clear() {
   std::fill(free_.begin(), free_.end(), 0);
   std::fill(occupied_.begin(), occupied_.end(), 0);
   std::fill(clear_low_.begin(), clear_low_.end(), 0);
+  std::fill(low_directions_.begin(), low_directions_.end(), std::uint8_t{0});
   outside_ = 0;
 }
 
@@ -73,7 +78,32 @@ bool FreeSpaceGrid::clear_below_sensor(int x, int y, unsigned min_rays) const {
          min_rays;
 }
 
+std::uint8_t FreeSpaceGrid::clear_directions(int x, int y) const {
+  if (x < 0 || y < 0 || x >= config_.width || y >= config_.height) return 0;
+  return low_directions_[static_cast<std::size_t>(y) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x)];
+}
+
+bool FreeSpaceGrid::clear_across(int x, int y) const {
+  const unsigned mask = clear_directions(x, y);
+  // Two sectors with one between them, either way round the half turn: rays at least one
+  // sector's width apart.
+  for (int i = 0; i < kDirectionSectors; ++i) {
+    if ((mask & (1u << i)) == 0) continue;
+    for (int j = i + 2; j < kDirectionSectors; ++j) {
+      if ((mask & (1u << j)) != 0 && kDirectionSectors - (j - i) >= 2) return true;
+    }
+  }
+  return false;
+}
+
 void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending) {
+  std::uint8_t sector_bit = 0;
+  if (descending && (x1 != x0 || y1 != y0)) {
+    double angle = std::atan2(static_cast<double>(y1 - y0), static_cast<double>(x1 - x0));  // (-pi, pi]
+    if (angle < 0) angle += kPi;                                                             // a line's direction
+    const int sector = std::min(kDirectionSectors - 1, static_cast<int>(angle / kPi * kDirectionSectors));
+    sector_bit = static_cast<std::uint8_t>(1u << sector);
+  }
   const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0);
   const int sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
   int err = dx + dy;
@@ -83,6 +113,7 @@ void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool
     const std::size_t k = static_cast<std::size_t>(y0) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x0);
     if (free_[k] < 0xFFFF) ++free_[k];
     if (descending && clear_low_[k] < 0xFFFF) ++clear_low_[k];
+    low_directions_[k] |= sector_bit;
     if (end) break;
     const int e2 = 2 * err;
     if (e2 >= dy) {
@@ -96,23 +127,24 @@ void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool
   }
 }
 
-void FreeSpaceGrid::Shift(std::vector<std::uint16_t>& cells, int dx, int dy) const {
+template <typename T>
+void FreeSpaceGrid::Shift(std::vector<T>& cells, int dx, int dy) const {
   // new(x, y) = old(x + dx, y + dy), zero where that is outside. Rows are visited in the order
   // that reads each source row before it is overwritten.
   const int w = config_.width, h = config_.height;
   const int keep = std::max(0, w - std::abs(dx));
   for (int i = 0; i < h; ++i) {
     const int y = dy >= 0 ? i : h - 1 - i;
-    std::uint16_t* row = cells.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    T* row = cells.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
     const int src_y = y + dy;
     if (src_y < 0 || src_y >= h || keep == 0) {
-      std::fill(row, row + w, std::uint16_t{0});
+      std::fill(row, row + w, T{0});
       continue;
     }
-    const std::uint16_t* src = cells.data() + static_cast<std::size_t>(src_y) * static_cast<std::size_t>(w);
-    std::memmove(row + std::max(0, -dx), src + std::max(0, dx), static_cast<std::size_t>(keep) * sizeof(std::uint16_t));
-    if (dx > 0) std::fill(row + keep, row + w, std::uint16_t{0});
-    if (dx < 0) std::fill(row, row - dx, std::uint16_t{0});
+    const T* src = cells.data() + static_cast<std::size_t>(src_y) * static_cast<std::size_t>(w);
+    std::memmove(row + std::max(0, -dx), src + std::max(0, dx), static_cast<std::size_t>(keep) * sizeof(T));
+    if (dx > 0) std::fill(row + keep, row + w, T{0});
+    if (dx < 0) std::fill(row, row - dx, T{0});
   }
 }
 
@@ -136,6 +168,7 @@ bool FreeSpaceGrid::Follow(const Eigen::Vector2f& sensor_m) {
   Shift(free_, dx, dy);
   Shift(occupied_, dx, dy);
   Shift(clear_low_, dx, dy);
+  Shift(low_directions_, dx, dy);
   moved_cells_ += Eigen::Vector2i(dx, dy);  // summed in cells: no rounding drift over many moves
   config_.origin_m = origin0_m_ + moved_cells_.cast<float>() * r;
   ++moves_;

@@ -13,6 +13,14 @@
 //   orientations their rectangle allows (two, four for a square): the symmetry ambiguity of a
 //   rectangle is carried as separate hypotheses;
 // - seeds given by the caller (room descriptor matches).
+// Besides, one-direction alignments ("channels"): every pair of walls, one of each map, gives a
+// yaw and an offset across the two walls' common line but nothing along it. Pairs are grouped
+// by (yaw, line direction, offset across); a family whose walls could coincide along at least
+// `min_channel_agreement_m` (the sum over its pairs of the shorter wall) is scored at the mean
+// of its pairs' offsets along the line, refined, and kept in `channels()` (the strongest
+// `max_channels` by agreement), whatever it fixes across. Two robots that share nothing but a
+// long corridor agree on it along one direction only; no corner pair proposes that, and a
+// weaker transform elsewhere must not win as if it had no rival (merge_rule.hpp, rule 3).
 // Candidates are clustered on a (yaw, x, y) grid; each cluster's mean is scored by wall
 // agreement, kept when it constrains both directions at least `keep_constraint_m`, refined on its
 // coinciding walls, scored again and merged with any hypothesis it became. The result is sorted by
@@ -51,12 +59,23 @@ struct AlignmentSearchConfig {
   std::size_t max_corners = 2048;     ///< per map
   std::size_t max_clusters = 65536;   ///< a power of two
   std::size_t max_hypotheses = 256;
+  /// One-direction families worth scoring: the merge rule's min_agreement_m (a family whose
+  /// walls cannot coincide along that much cannot out-agree any leader). 0: no channels.
+  double min_channel_agreement_m = 8.0;
+  std::size_t max_channels = 16;            ///< the strongest families kept
+  std::size_t max_channel_families = 16384;  ///< a power of two
   WallAgreementConfig agreement;
   Status Validate() const;
 };
 
 /// Where a hypothesis came from (bits).
-enum HypothesisSource : std::uint8_t { kFromCorners = 1, kFromRooms = 2, kFromSeed = 4, kFromSymmetry = 8 };
+enum HypothesisSource : std::uint8_t {
+  kFromCorners = 1,
+  kFromRooms = 2,
+  kFromSeed = 4,
+  kFromSymmetry = 8,
+  kFromChannel = 16,
+};
 
 struct Hypothesis {
   PlanarTransform T_a_b;
@@ -72,6 +91,7 @@ struct AlignmentSearchStats {
   std::size_t corners_a = 0, corners_b = 0;
   std::size_t candidates = 0, clusters = 0, kept = 0;
   std::size_t clusters_dropped = 0, hypotheses_dropped = 0, corners_dropped = 0;
+  std::size_t channel_families = 0, channels_scored = 0, channel_families_dropped = 0;
 };
 
 /// A corner of one map (its two walls' lines meet there) and a cluster of candidate transforms.
@@ -81,6 +101,14 @@ struct AlignmentCorner {
   double opening_rad = 0;  ///< from the first wall's normal to the second's, in (0, pi)
   std::int8_t side_i = 0, side_j = 0;
   std::uint32_t wall_i = 0, wall_j = 0;
+};
+/// A family of wall pairs that agree on a yaw and an offset across one line direction.
+struct AlignmentChannelFamily {
+  std::uint64_t key = 0;
+  bool used = false;
+  double weight_m = 0;  ///< sum of the shorter wall of each pair: the most they could agree
+  double cos_sum = 0, sin_sum = 0, across_sum = 0, along_sum = 0;
+  Eigen::Vector2d n = Eigen::Vector2d::UnitX();  ///< the line's normal (canonical), map a
 };
 struct AlignmentCluster {
   std::uint64_t key = 0;
@@ -104,10 +132,14 @@ class AlignmentSearch {
 
   std::span<Hypothesis> hypotheses() { return hypotheses_.span(); }
   std::span<const Hypothesis> hypotheses() const { return hypotheses_.span(); }
+  /// One-direction alignments (not of a self search), strongest first.
+  std::span<const Hypothesis> channels() const { return channels_.span(); }
   const AlignmentSearchStats& stats() const { return stats_; }
   /// Candidates were lost (a full corner store or cluster table): a rival may be missing. A full
   /// hypothesis store only drops the weakest, which cannot decide anything.
-  bool truncated() const { return stats_.clusters_dropped > 0 || stats_.corners_dropped > 0; }
+  bool truncated() const {
+    return stats_.clusters_dropped > 0 || stats_.corners_dropped > 0 || stats_.channel_families_dropped > 0;
+  }
   const AlignmentSearchConfig& config() const { return config_; }
 
   /// Refines and scores one transform (a composite of a symmetry and a hypothesis, say).
@@ -119,11 +151,14 @@ class AlignmentSearch {
   void Corners(const WallIndex& walls, BoundedVector<Corner>& out);
   void Vote(const PlanarTransform& T, std::uint32_t votes, std::uint8_t source);
   void Keep(const Hypothesis& h);
+  void Channels(const WallIndex& a, const WallIndex& b);
 
   AlignmentSearchConfig config_;
   BoundedVector<Corner> corners_a_, corners_b_;
   std::vector<Cluster> clusters_;
   BoundedVector<Hypothesis> hypotheses_;
+  std::vector<AlignmentChannelFamily> families_;
+  BoundedVector<Hypothesis> channels_;
   AlignmentSearchStats stats_;
 };
 

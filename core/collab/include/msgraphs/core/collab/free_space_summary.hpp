@@ -10,7 +10,11 @@
 //   rays through it; a few grazing returns off a door's jamb do not close the door);
 // - free when at least `min_free_share` of its fine cells are clear below the sensor (crossed by
 //   descending rays: no obstacle as tall as a wall can stand there, whatever passed over a rack
-//   towards the ceiling) and none is occupied;
+//   towards the ceiling) and none is a wall seen edge-on: returns in the obstacle band there
+//   (FreeSpaceGrid::ever_occupied), rays through it in one direction only
+//   (FreeSpaceGrid::clear_across), and more returns a step or two along those rays. Its
+//   grazing rays outnumber its returns, so the fine grid reads it "not occupied", but it is
+//   no free space;
 // - unknown otherwise.
 // And the openings: where the robot saw through one of its own walls (a door, a wide opening),
 // from the fine grid: clear on both sides of the wall's line and no return ever across its body

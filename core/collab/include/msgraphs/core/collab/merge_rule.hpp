@@ -79,6 +79,10 @@ struct MergeRuleConfig {
   /// Slides of the leader along each principal direction probed each way (rule 4); 0: none. The
   /// probes are 2 agreement offsets apart, wider when b's extent needs more than this many.
   std::size_t max_slide_probes = 128;
+  /// Rule 3 in one direction: the search's channels (alignments along one wall line, which fix
+  /// nothing along it) probed along that line; one that agrees at least as much as the leader
+  /// and stands makes the decision ambiguous. Off only to measure what it costs.
+  bool one_direction_rivals = true;
   /// A new merge needs the same leader to win this many decisions, no other leader winning in
   /// between (each decision is on new data: the search and the rule run when a map or a free
   /// space changed), so that what the robots see next can refute it before it is acted on: two
@@ -138,6 +142,7 @@ struct MergeDecision {
   Hypothesis best_refuted;
   bool has_best_refuted = false;
   bool rival_from_symmetry = false;  ///< the rival is a symmetry of one map composed with the leader
+  bool rival_one_direction = false;  ///< the rival fixes one direction only (a channel)
   bool symmetric = false;            ///< a symmetry alternative stands: the wider margin applied
   bool keeping = false;     ///< the leader is the current merge (hysteresis applied)
   bool overturned = false;  ///< kAmbiguous while merged, and the rival beats the current merge
@@ -156,6 +161,7 @@ struct MergeInputs {
   std::span<Hypothesis> hypotheses;  ///< conflicts are filled in as the rule needs them
   bool truncated = false;
   std::span<const Hypothesis> sym_a, sym_b;
+  std::span<const Hypothesis> channels;  ///< AlignmentSearch::channels(): one-direction alignments
 };
 
 /// Decides. `search` evaluates the symmetry alternatives. `current` (optional): the transform

@@ -50,6 +50,15 @@ class FreeSpaceGrid {
   bool ever_occupied(int x, int y) const;
   /// True when at least `min_rays` descending rays crossed the cell (see the header comment).
   bool clear_below_sensor(int x, int y, unsigned min_rays = 1) const;
+  /// True when descending rays crossed the cell in two directions at least one sector
+  /// (`kDirectionSectors` over a half turn) apart. A wall seen edge-on is crossed only by the
+  /// rays that graze along it, all in one direction; a place seen through is crossed from
+  /// wherever the robot stood.
+  bool clear_across(int x, int y) const;
+  /// The sectors of the descending rays that crossed the cell, a bit each.
+  std::uint8_t clear_directions(int x, int y) const;
+  /// Ray directions are kept in this many sectors of a half turn (22.5 degrees each).
+  static constexpr int kDirectionSectors = 8;
   bool ToCell(const Eigen::Vector2d& p, int& x, int& y) const;
   Eigen::Vector2d CellCentre(int x, int y) const;
   int width() const { return config_.width; }
@@ -67,12 +76,14 @@ class FreeSpaceGrid {
 
  private:
   void Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending);
-  void Shift(std::vector<std::uint16_t>& cells, int dx, int dy) const;
+  template <typename T>
+  void Shift(std::vector<T>& cells, int dx, int dy) const;
 
   FreeSpaceGridConfig config_;
   std::vector<std::uint16_t> free_;
   std::vector<std::uint16_t> occupied_;
   std::vector<std::uint16_t> clear_low_;
+  std::vector<std::uint8_t> low_directions_;  // per cell: a bit per sector of descending rays crossing it
   std::uint64_t outside_ = 0;
   std::uint64_t moves_ = 0;
   Eigen::Vector2f origin0_m_ = Eigen::Vector2f::Zero();  // the configured origin
