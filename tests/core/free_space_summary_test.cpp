@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <span>
 #include <vector>
 
@@ -151,6 +153,27 @@ TEST(FreeSpaceSummary, APlaceSeenThroughFromTwoDirectionsIsFreeWhateverReturnedO
   ASSERT_TRUE(summary.Init({}));
   ASSERT_TRUE(summary.Build(grid, {}));
   EXPECT_EQ(summary.state_at({0.05, 0.05}), SummaryCell::kFree);
+}
+
+// Each descending ray marks the cells it crosses with the sector (8 over a half turn) of its
+// line's direction, whichever way it points: rays every 5 degrees round the full turn, each into
+// a fresh grid, from the cell centre at the origin to a floor point 4 m away.
+TEST(FreeSpaceGrid, ARayMarksTheSectorOfItsLineDirection) {
+  for (int k = 0; k < 72; ++k) {
+    const double angle = (5.0 * k + 1.3) * std::numbers::pi / 180.0;
+    FreeSpaceGrid grid = Grid();
+    const Eigen::Vector3f end(static_cast<float>(4.0 * std::cos(angle)) + 0.05f,
+                              static_cast<float>(4.0 * std::sin(angle)) + 0.05f, 0.0f);
+    grid.Integrate({0.05f, 0.05f, 0.8f}, std::span<const Eigen::Vector3f>(&end, 1), 0.0f);
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    ASSERT_TRUE(grid.ToCell({0.05, 0.05}, x0, y0));
+    ASSERT_TRUE(grid.ToCell(end.head<2>().cast<double>(), x1, y1));
+    // The sector of the cell-to-cell direction the grid traces (within a cell of the angle's).
+    double line = std::atan2(static_cast<double>(y1 - y0), static_cast<double>(x1 - x0));
+    if (line < 0) line += std::numbers::pi;
+    const int sector = std::min(7, static_cast<int>(line / std::numbers::pi * 8));
+    EXPECT_EQ(grid.clear_directions(x0, y0), 1u << sector) << 5 * k + 1.3 << " degrees";
+  }
 }
 
 // free_space_summary.hpp: "Build and Decode allocate nothing". The grid, both summaries (Init)

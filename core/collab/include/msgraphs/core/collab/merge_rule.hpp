@@ -13,7 +13,11 @@
 //    fixed, not a corridor's slide), and its own conflict must be at most `accept_conflict_m`.
 // 3. Every other hypothesis not refuted that constrains both directions at least
 //    `min_rival_constraint_m` is a rival; the leader must beat each by the margin:
-//    agreement >= margin_ratio * rival's + margin_m.
+//    agreement >= margin_ratio * rival's + margin_m. In one direction too: a channel of the
+//    search (an alignment along one wall line, alignment_search.hpp), probed along that line
+//    where the rule would merge, that agrees at least as much as the leader and stands is a
+//    rival the leader cannot beat (`one_direction_rivals`): robots that share only a corridor
+//    agree along it and fix nothing along it, and no corner pair proposes that.
 // 4. Symmetry: each map's own symmetries (the alignment search of a map with itself: a row of
 //    identical rooms, a room's half turn) composed with the leader give alternatives that lay b
 //    on another copy of the same structure. If one of them is not refuted, the structure the
