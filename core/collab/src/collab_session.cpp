@@ -186,12 +186,19 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
     p.symmetries.Init(config.merge.max_symmetries);
   }
   if (auto s = m.search.Init(config.search); !s) return s;
-  if (auto s = m.symmetry_search.Init(config.search); !s) return s;
+  // A map against itself has no channels (Search(..., self) skips them): no table for them.
+  AlignmentSearchConfig self_search = config.search;
+  self_search.min_channel_agreement_m = 0;
+  self_search.max_channels = 0;
+  self_search.max_channel_families = 16;
+  if (auto s = m.symmetry_search.Init(self_search); !s) return s;
   m.seeds.Init(config.max_matches_per_peer);
   m.log.assign(config.max_log, MergeLogEntry{});
   m.log_sequence = 0;
   const std::size_t search_bytes =
       config.search.max_clusters * 56 + 2 * config.search.max_corners * 48 + config.search.max_hypotheses * sizeof(Hypothesis);
+  bytes += config.search.max_channel_families * sizeof(AlignmentChannelFamily) +
+           config.search.max_channels * sizeof(Hypothesis);
   bytes += (config.max_peers + 1) * (walls * sizeof(AlignWall) + free_bytes +
                                      config.merge.max_symmetries * sizeof(Hypothesis)) +
            config.free_space.max_cells + 2 * search_bytes + config.max_log * sizeof(MergeLogEntry);

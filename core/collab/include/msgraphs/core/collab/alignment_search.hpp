@@ -63,7 +63,11 @@ struct AlignmentSearchConfig {
   /// walls cannot coincide along that much cannot out-agree any leader). 0: no channels.
   double min_channel_agreement_m = 8.0;
   std::size_t max_channels = 16;            ///< the strongest families kept
-  std::size_t max_channel_families = 16384;  ///< a power of two
+  /// A power of two; filled to three quarters at most (then truncated: the rule refuses to
+  /// decide). Families are (yaw, line, offset across) bins of wall pairs: a few thousand for two
+  /// maps of a few hundred walls each (none truncated over the 40-mission benchmark); 64 Ki
+  /// entries (4.7 MB) leave room for two maps at the distiller's 1,024 walls in a few directions.
+  std::size_t max_channel_families = 65536;
   WallAgreementConfig agreement;
   Status Validate() const;
 };
