@@ -134,6 +134,17 @@ std::vector<ViewExplanation> ExplainViews(const Mission& mission, const Evaluati
     static_cast<void>(own[i].Init(s.config().distiller.max_walls));
     own[i].Build(s.distilled().walls.span(), s.config().search.min_wall_length_m);
     symmetries[i] = Symmetries(own[i], s.distilled(), s.config());
+    // Rule 6's evidence: the robot's walls in its own free space, stretch by stretch.
+    if (pictures_dir.empty() || i >= evaluation.robots.size()) continue;
+    const std::string path = pictures_dir + "/robot" + std::to_string(i + 1) + "_self_conflicts.csv";
+    if (std::FILE* file = std::fopen(path.c_str(), "w")) {
+      std::fprintf(file, "# the robot's walls in its own free space (rule 6), stretch by stretch, world frame (truth)\n"
+                         "direction,kind,ax_m,ay_m,bx_m,by_m,length_m\n");
+      ConflictCsv self(file, "self", evaluation.robots[i].own.T_truth_estimate);
+      static_cast<void>(core::ConflictOf(own[i], s.free_space(), core::PlanarTransform{}, own[i], s.free_space(),
+                                         s.config().merge.conflict, &self, false));
+      std::fclose(file);
+    }
   }
   core::AlignmentSearch search;
   for (const ViewEvaluation& v : evaluation.views) {
