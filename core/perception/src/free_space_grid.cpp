@@ -114,8 +114,7 @@ bool FreeSpaceGrid::clear_across(int x, int y) const {
 }
 
 void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending) {
-  const std::uint8_t sector_bit =
-      descending && (x1 != x0 || y1 != y0) ? static_cast<std::uint8_t>(1u << Sector(x1 - x0, y1 - y0)) : 0;
+  const unsigned sector_bit = descending && (x1 != x0 || y1 != y0) ? 1u << Sector(x1 - x0, y1 - y0) : 0u;
   const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0);
   const int sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
   int err = dx + dy;
@@ -125,7 +124,7 @@ void FreeSpaceGrid::Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool
     const std::size_t k = static_cast<std::size_t>(y0) * static_cast<std::size_t>(config_.width) + static_cast<std::size_t>(x0);
     if (free_[k] < 0xFFFF) ++free_[k];
     if (descending && clear_low_[k] < 0xFFFF) ++clear_low_[k];
-    low_directions_[k] |= sector_bit;
+    low_directions_[k] = static_cast<std::uint8_t>(low_directions_[k] | sector_bit);
     if (end) break;
     const int e2 = 2 * err;
     if (e2 >= dy) {
