@@ -15,6 +15,19 @@ bool Beats(const Hypothesis& leader, const Hypothesis& rival, double ratio, cons
   return leader.agreement.agreement_m >= ratio * rival.agreement.agreement_m + c.margin_m;
 }
 
+// How far b's walls, laid by T, extend along `dir`: the range a slide along it is probed over.
+double SpanAlong(const WallIndex& walls_b, const PlanarTransform& T, const Eigen::Vector2d& dir) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const AlignWall& w : walls_b.walls()) {
+    for (const Eigen::Vector2d& p : {w.a, w.b}) {
+      const double s = dir.dot(T * p);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+  }
+  return hi > lo ? hi - lo : 0.0;
+}
+
 }  // namespace
 
 const char* ToString(MergeVerdict v) {
@@ -73,15 +86,7 @@ bool OneDirectionRival(const Hypothesis& ch, const Hypothesis& L, MergeInputs& i
   if (SameTransform(ch.T_a_b, L.T_a_b, sc.same_distance_m, sc.same_angle_rad)) return false;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(ch.agreement.information);
   const Eigen::Vector2d dir = eig.eigenvectors().col(0);  // the weaker direction
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const AlignWall& w : in.walls_b->walls()) {
-    for (const Eigen::Vector2d& p : {w.a, w.b}) {
-      const double s = dir.dot(ch.T_a_b * p);
-      lo = std::min(lo, s);
-      hi = std::max(hi, s);
-    }
-  }
-  const double span_m = hi > lo ? hi - lo : 0.0;
+  const double span_m = SpanAlong(*in.walls_b, ch.T_a_b, dir);
   const double step_m = std::max(2 * sc.agreement.offset_m, span_m / static_cast<double>(std::max<std::size_t>(1, c.max_slide_probes)));
   for (double s = 0; s <= span_m; s += step_m) {
     for (const double sign : {1.0, -1.0}) {
@@ -253,15 +258,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(L.agreement.information);
     for (int axis = 0; axis < 2; ++axis) {
       const Eigen::Vector2d dir = eig.eigenvectors().col(axis);
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (const AlignWall& w : in.walls_b->walls()) {
-        for (const Eigen::Vector2d& p : {w.a, w.b}) {
-          const double s = dir.dot(L.T_a_b * p);
-          lo = std::min(lo, s);
-          hi = std::max(hi, s);
-        }
-      }
-      const double span_m = hi > lo ? hi - lo : 0.0;
+      const double span_m = SpanAlong(*in.walls_b, L.T_a_b, dir);
       const double step_m =
           std::max(2 * search.config().agreement.offset_m, span_m / static_cast<double>(c.max_slide_probes));
       for (double s = step_m; s <= span_m; s += step_m) {
