@@ -8,7 +8,7 @@ figure). Exit 1 when a measured stage exceeds its budget, 2 on a usage or measur
 
 Sources: "bench:<binary>:<benchmark>" runs build/bench/msgraphs_<binary>_bench (Google
 Benchmark, JSON); "slam:<stage>" runs msgraphs_slam on RUN's robot (per-stage percentiles of a
-keyframe and the peak RSS), or reads --slam-log (repeatable: the worst of each statistic
+keyframe and the peak RSS; the median of each over --repeat runs), or reads --slam-log (repeatable: the worst of each statistic
 over the runs); "fleet:<key>" reads every node's stats.txt in
 FLEET_OUT/nodes/robotN (the largest). Rows whose source is absent are reported as not measured
 (a benchmark that needs ../shared/data without it, no --fleet) and do not fail the check.
@@ -96,6 +96,8 @@ def main():
     ap.add_argument("--slam-log", action="append",
                     help="msgraphs_slam output to read instead of running it; repeated, the worst of "
                          "each statistic over all of them is checked")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="msgraphs_slam runs on --run; each statistic is the median over them")
     ap.add_argument("--fleet", help="scripts/run_fleet.sh output folder (node memory)")
     ap.add_argument("--budgets", default=os.path.join(os.path.dirname(__file__), "budgets.txt"))
     ap.add_argument("--data", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -130,12 +132,23 @@ def main():
                     for k, v in stats.items():
                         worst[k] = max(worst.get(k, v), v)
         elif args.run and any(r["source"].startswith("slam:") for r in rows):
+            # A p99 from one run varies by about 10 % on a shared machine (six runs of one binary
+            # on one recording: 8.4 to 10.9 ms for the sweep): each statistic is the median over
+            # --repeat runs, so that one unlucky run neither fails nor passes the check alone.
             exe = os.path.join(args.build, "tools", "msgraphs_slam")
-            out = subprocess.run([exe, "--run", args.run, "--robot", str(args.robot)],
-                                 capture_output=True, text=True)
-            if out.returncode != 0:
-                raise RuntimeError(f"msgraphs_slam failed: {out.stderr.strip()[-400:]}")
-            slam = parse_slam(out.stdout)
+            runs = []
+            for _ in range(max(1, args.repeat)):
+                out = subprocess.run([exe, "--run", args.run, "--robot", str(args.robot)],
+                                     capture_output=True, text=True)
+                if out.returncode != 0:
+                    raise RuntimeError(f"msgraphs_slam failed: {out.stderr.strip()[-400:]}")
+                runs.append(parse_slam(out.stdout))
+            slam = {}
+            for stage in runs[0]:
+                slam[stage] = {}
+                for k in runs[0][stage]:
+                    values = sorted(r[stage][k] for r in runs if k in r.get(stage, {}))
+                    slam[stage][k] = values[len(values) // 2]
     except (OSError, RuntimeError, ValueError) as e:
         print(f"budget_check: {e}", file=sys.stderr)
         return 2

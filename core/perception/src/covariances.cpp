@@ -22,12 +22,16 @@ Expected<CovarianceStats> EstimateCovariances(std::span<const Eigen::Vector3f> p
   std::uint32_t idx[KdTree::kMaxK];
   float d2[KdTree::kMaxK];
   const float max_d2 = config.max_neighbour_distance_m * config.max_neighbour_distance_m;
-  for (const Eigen::Vector3f& p : points) {
+  // Filled by index, visited in the tree's leaf order (consecutive queries share their paths).
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    normals.push_back(Eigen::Vector3f::Zero());
+    covariances.push_back(Eigen::Matrix3f::Identity() * 1e-2f);
+  }
+  for (const std::uint32_t at : tree.leaf_order()) {
+    const Eigen::Vector3f& p = points[at];
     const std::size_t n = tree.Knn(p, config.neighbours, idx, d2, max_d2);
     if (n < 5) {
-      ++stats.degenerate;
-      normals.push_back(Eigen::Vector3f::Zero());
-      covariances.push_back(Eigen::Matrix3f::Identity() * 1e-2f);
+      ++stats.degenerate;  // left as the small sphere
       continue;
     }
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -45,8 +49,8 @@ Expected<CovarianceStats> EstimateCovariances(std::span<const Eigen::Vector3f> p
     Eigen::Vector3d normal = U.col(0);
     if (viewpoint != nullptr && normal.dot((*viewpoint - p).cast<double>()) < 0) normal = -normal;
     const Eigen::Matrix3d C = U * Eigen::Vector3d(1e-3, 1.0, 1.0).asDiagonal() * U.transpose();
-    normals.push_back(normal.cast<float>());
-    covariances.push_back(C.cast<float>());
+    normals[at] = normal.cast<float>();
+    covariances[at] = C.cast<float>();
   }
   return stats;
 }

@@ -98,8 +98,10 @@ std::size_t KdTree::Knn(const Eigen::Vector3f& q, std::size_t k, std::span<std::
     const float diff = q[n.axis] - n.split;
     const std::uint32_t near = diff < 0 ? n.a : n.b;
     const std::uint32_t far = diff < 0 ? n.b : n.a;
-    stack[top++] = {far, diff * diff};  // visited after the near side
-    stack[top++] = {near, 0.0f};
+    // The far side lies inside this node's region and beyond the split plane: both distances
+    // bound it from below, and the larger prunes more.
+    stack[top++] = {far, std::max(item.bound, diff * diff)};  // visited after the near side
+    stack[top++] = {near, item.bound};
   }
   return found;
 }

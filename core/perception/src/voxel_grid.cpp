@@ -34,9 +34,7 @@ bool VoxelKey(const Eigen::Vector3f& p, float inverse_leaf, std::uint64_t& key) 
 void VoxelDownsampler::Init(std::size_t max_voxels) {
   std::size_t table = 16;
   while (table < 2 * max_voxels) table *= 2;
-  keys_.assign(table, 0);
-  slot_epoch_.assign(table, 0);
-  slot_value_.assign(table, 0);
+  slots_.assign(table, Slot{});
   sum_.assign(max_voxels, Eigen::Vector3d::Zero());
   count_.assign(max_voxels, 0);
   epoch_ = 0;
@@ -53,11 +51,11 @@ Status VoxelDownsampler::Downsample(std::span<const Eigen::Vector3f> points,
     return Error{Errc::kInvalidArgument, "voxel grid: leaf must be > 0"};
   if (sum_.empty()) return Error{Errc::kInvalidArgument, "voxel grid: Init was not called"};
   if (++epoch_ == 0) {  // wrapped: forget every slot explicitly
-    std::fill(slot_epoch_.begin(), slot_epoch_.end(), 0);
+    for (Slot& s : slots_) s.epoch = 0;
     epoch_ = 1;
   }
   const float inverse_leaf = 1.0f / leaf_m;
-  const std::size_t mask = keys_.size() - 1;
+  const std::size_t mask = slots_.size() - 1;
   std::uint32_t used = 0;
   for (const Eigen::Vector3f& p : points) {
     std::uint64_t key = 0;
@@ -65,21 +63,20 @@ Status VoxelDownsampler::Downsample(std::span<const Eigen::Vector3f> points,
       ++stats_.rejected;
       continue;
     }
-    std::size_t slot = VoxelHash(key) & mask;
-    while (slot_epoch_[slot] == epoch_ && keys_[slot] != key) slot = (slot + 1) & mask;
-    if (slot_epoch_[slot] != epoch_) {
+    std::size_t i = VoxelHash(key) & mask;
+    while (slots_[i].epoch == epoch_ && slots_[i].key != key) i = (i + 1) & mask;
+    Slot& slot = slots_[i];
+    if (slot.epoch != epoch_) {
       if (used == sum_.size()) {
         ++stats_.overflowed;
         continue;
       }
-      slot_epoch_[slot] = epoch_;
-      keys_[slot] = key;
-      slot_value_[slot] = used;
+      slot = {key, epoch_, used};
       sum_[used].setZero();
       count_[used] = 0;
       ++used;
     }
-    const std::uint32_t v = slot_value_[slot];
+    const std::uint32_t v = slot.value;
     sum_[v] += p.cast<double>();
     ++count_[v];
   }

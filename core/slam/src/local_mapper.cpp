@@ -90,6 +90,7 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   const std::size_t local_n = n * 2;  // the local map, after downsampling
   extractor_.Init(n);
   voxel_.Init(std::max(n, config.local_map_keyframes * n));
+  scan_voxel_.Init(n);
   tree_.Init(n);
   local_tree_.Init(local_n);
   local_map_.Init(local_n);
@@ -153,7 +154,7 @@ bool LocalMapper::Preprocess(const LidarScanView& scan,
                              const Eigen::Isometry3d& T_odom_end, bool buffered) {
   if (!prepared_) PrepareSweep(scan, T_odom_start, T_odom_end, buffered);
   prepared_ = false;
-  if (!voxel_.Downsample(filtered_.span(), config_.voxel_m, down_) || down_.size() < 100)
+  if (!scan_voxel_.Downsample(filtered_.span(), config_.voxel_m, down_) || down_.size() < 100)
     return false;
   if (!tree_.Build(down_.span())) return false;
   const Eigen::Vector3f viewpoint = config_.T_base_lidar.translation().cast<float>();
@@ -392,7 +393,7 @@ Expected<ScanOutcome> LocalMapper::AddScanImpl(const LidarScanView& scan, StageO
   static_cast<void>(planes_mapper_.Associate(graph_, id, planes_.span()));
   Stage(observer, MapperStage::kPlanes);
   // Stored cloud and descriptor.
-  if (voxel_.Downsample(down_.span(), config_.store_voxel_m, stored_)) {
+  if (scan_voxel_.Downsample(down_.span(), config_.store_voxel_m, stored_)) {
     static_cast<void>(clouds_.Put(id, sequence_[id], stored_.span()));
     static_cast<void>(loops_.AddKeyframe(id, sequence_[id], path_m_, stored_.span()));
   }

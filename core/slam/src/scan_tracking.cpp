@@ -51,7 +51,7 @@ Eigen::Isometry3d LocalMapper::Track(const LidarScanView& scan, const Eigen::Iso
   PrepareSweep(scan, T_odom_start, T_odom_end, true);
   prepared_ = true;
   const Eigen::Vector3f viewpoint = config_.T_base_lidar.translation().cast<float>();
-  if (!voxel_.Downsample(filtered_.span(), config_.tracking_voxel_m, track_down_) ||
+  if (!scan_voxel_.Downsample(filtered_.span(), config_.tracking_voxel_m, track_down_) ||
       track_down_.size() < 50 || !track_tree_.Build(track_down_.span()) ||
       !EstimateCovariances(track_down_.span(), track_tree_, {}, track_normals_, track_covariances_,
                            &viewpoint)) {

@@ -25,6 +25,9 @@ class KdTree {
   /// beyond capacity; kInvalidArgument for a non-finite point (filter first).
   Status Build(std::span<const Eigen::Vector3f> points);
   std::size_t size() const { return points_.size(); }
+  /// The indexed points' indices in leaf order: neighbours in space are neighbours here, so
+  /// queries made in this order reuse the same nodes and points (the cache and the branches).
+  std::span<const std::uint32_t> leaf_order() const { return {index_.data(), points_.size()}; }
 
   /// The up to k nearest points within sqrt(max_dist2), nearest first. Returns how many were
   /// written to `indices`/`dist2` (both at least k long, k <= kMaxK).

@@ -51,9 +51,14 @@ class VoxelDownsampler {
   std::size_t peak_voxels() const { return peak_; }
 
  private:
-  std::vector<std::uint64_t> keys_;
-  std::vector<std::uint32_t> slot_epoch_;
-  std::vector<std::uint32_t> slot_value_;
+  // One slot's key, epoch and voxel index side by side: a probe into a table much larger than
+  // the cache costs one miss, not three.
+  struct Slot {
+    std::uint64_t key = 0;
+    std::uint32_t epoch = 0;  ///< the slot is in use in this call when equal to epoch_
+    std::uint32_t value = 0;  ///< index into sum_ / count_
+  };
+  std::vector<Slot> slots_;
   std::vector<Eigen::Vector3d> sum_;
   std::vector<std::uint32_t> count_;
   std::uint32_t epoch_ = 0;

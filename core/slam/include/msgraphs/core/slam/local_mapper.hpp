@@ -376,7 +376,8 @@ class LocalMapper {
   LoopCloser loops_;
   FreeSpaceGrid grid_;
   PlaneExtractor extractor_;
-  VoxelDownsampler voxel_;
+  VoxelDownsampler voxel_;       ///< the local map's points (local_map_keyframes scans)
+  VoxelDownsampler scan_voxel_;  ///< one scan's: a table that stays in cache, not the local map's
   KdTree tree_, local_tree_;
   GaussianVoxelMap local_map_;
   Vgicp vgicp_;
