@@ -12,6 +12,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -89,6 +90,52 @@ TEST(CollabSim, TheDemoMissionMergesEveryViewAndNeverWrongly) {
   EXPECT_LT(rmse2_z, 0.3);
   std::filesystem::remove_all(run);
   std::filesystem::remove_all(out);
+  std::filesystem::remove(log);
+}
+
+
+// Feedback is its own switch, not a side effect of the mode (issue 19's confounded ablation):
+// in the rooms-only mode the merge's matched walls still reach each robot's own S-Graph as
+// priors (they were collected only in the walls modes, so "Rooms" silently ran without
+// feedback), and --feedback off leaves every own map without them.
+std::size_t PriorsOfRobot(const std::string& text, int robot) {
+  const std::regex line("feedback \\((on|off)\\): wall priors from peers[^\\n]*");
+  std::smatch m;
+  if (!std::regex_search(text, m, line)) return static_cast<std::size_t>(-1);
+  const std::regex entry("robot " + std::to_string(robot) + " ([0-9]+) \\(refused");
+  std::smatch e;
+  const std::string found = m.str();
+  if (!std::regex_search(found, e, entry)) return static_cast<std::size_t>(-1);
+  return static_cast<std::size_t>(std::stoul(e[1].str()));
+}
+
+TEST(CollabSim, TheRoomsModeFeedsMatchedWallsBackAndFeedbackOffFeedsNone) {
+  const std::string run = Temp("feedback_run"), log = Temp("feedback_log");
+  std::filesystem::remove_all(run);
+  ASSERT_EQ(
+      Wait(Spawn({MSGRAPHS_SIM_TOOL, "--world", MSGRAPHS_OFFICE_WORLD, "--out", run, "--robots",
+                  "2", "--duration-s", "150", "--seed", "1"})),
+      0);
+  auto collab = [&](const std::string& feedback) {
+    EXPECT_EQ(Wait(Spawn({"/bin/sh", "-c",
+                          std::string(MSGRAPHS_COLLAB_TOOL) + " --run " + run +
+                              " --mode rooms --feedback " + feedback + " > " + log})),
+              0);
+    std::ifstream in(log);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  const std::string on = collab("on");
+  ASSERT_NE(on.find("robot 1 merged 2 of 2 robots"), std::string::npos) << on;
+  EXPECT_GT(PriorsOfRobot(on, 1), 0u) << on;
+  EXPECT_GT(PriorsOfRobot(on, 2), 0u) << on;
+  EXPECT_NE(PriorsOfRobot(on, 1), static_cast<std::size_t>(-1));
+  const std::string off = collab("off");
+  ASSERT_NE(off.find("robot 1 merged 2 of 2 robots"), std::string::npos) << off;
+  EXPECT_EQ(PriorsOfRobot(off, 1), 0u) << off;
+  EXPECT_EQ(PriorsOfRobot(off, 2), 0u) << off;
+  std::filesystem::remove_all(run);
   std::filesystem::remove(log);
 }
 

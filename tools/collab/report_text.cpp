@@ -79,6 +79,17 @@ void RobotLines(const ReportInput& in, std::string& out) {
         r.own.pairs.DescribeUnpaired().c_str(), r.truth.samples().size(), r.truth.median_period_s(),
         r.truth.gap_limit_s());
   }
+  // What fed the collaborative estimate back into each own map (--feedback): the peers' walls
+  // held as priors on this robot's walls at the end.
+  if (in.mission.keyframes) return;
+  Add(out, "feedback (%s): wall priors from peers in each local S-Graph at the end:",
+      in.mission.feedback ? "on" : "off");
+  for (const auto& robot : in.mission.robots) {
+    const core::LocalMapperStats& s = robot->mapper.stats();
+    Add(out, " robot %d %zu (refused %llu);", robot->id(), s.plane_priors,
+        static_cast<unsigned long long>(s.plane_priors_refused));
+  }
+  Add(out, "\n");
 }
 
 void ViewTable(const ReportInput& in, std::string& out) {

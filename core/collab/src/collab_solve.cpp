@@ -4,8 +4,8 @@
 // matches the merge agrees with are tied room to room (corridors across their axis only), with
 // their walls wall to wall, and their fine alignments measure the origin directly; with fewer
 // than two such rooms (corridors not counted), the walls the merge lays on each other tie the
-// maps. And the priors that feed it all back into
-// the local S-Graph.
+// maps (wall to wall in the walls modes only). The wall pairs behind the priors that feed it all
+// back into the local S-Graph are collected in every mode: feedback is its own switch.
 #include <cmath>
 
 #include "collab_session_impl.hpp"
@@ -22,11 +22,17 @@ void CollabSession::Impl::Solve() {
   stats.solve_room_pairs = stats.solve_wall_pairs = stats.solve_origin_measurements = 0;
   const DistilledGraph& mine = distiller.graph();
   const double cos_pair = std::cos(config.wall_pair_angle_rad);
+  // A pair of coinciding walls: tied wall to wall in the walls modes, and in every mode kept for
+  // the priors that feed the peer's measurement back into the local S-Graph (PlanePriors), so
+  // that the ablation's modes differ in their factors only, and feedback is its own switch
+  // (the caller applies the priors or not).
   auto pair_walls = [&](Peer& p, const DistilledWall& A, const DistilledWall& B) {
-    auto wa_node = graph.AddWall(config.robot, A);
-    auto wb_node = graph.AddWall(p.robot, B);
-    if (!wa_node || !wb_node) return;
-    if (graph.AddWallWall(*wa_node, *wb_node)) ++stats.solve_wall_pairs;
+    if (config.mode.walls) {
+      auto wa_node = graph.AddWall(config.robot, A);
+      auto wb_node = graph.AddWall(p.robot, B);
+      if (!wa_node || !wb_node) return;
+      if (graph.AddWallWall(*wa_node, *wb_node)) ++stats.solve_wall_pairs;
+    }
     bool known = false;
     for (const SessionWallPair& q : wall_pairs) known = known || (q.own_wall == A.id && q.peer == p.robot && q.peer_wall == B.id);
     if (!known && !wall_pairs.try_push_back({A.id, B.id, p.robot})) ++stats.wall_pairs_refused;
@@ -70,7 +76,6 @@ void CollabSession::Impl::Solve() {
       // place a peer without the merge's walls.
       if (ra->shape != RoomShape::kCorridor && rb->shape != RoomShape::kCorridor) ++room_pairs;
       ++stats.solve_room_pairs;
-      if (!config.mode.walls) continue;
       for (std::int32_t wa : ra->walls) {
         const DistilledWall* A = wa < 0 ? nullptr : mine.FindWall(static_cast<std::uint32_t>(wa));
         if (A == nullptr) continue;
@@ -85,10 +90,9 @@ void CollabSession::Impl::Solve() {
       // Nothing room to room ties it enough: the merge itself measures the origin.
       static_cast<void>(
           graph.AddOriginMeasurement(p.robot, T_merge, config.fine_origin_sigma_m, config.fine_origin_sigma_rad));
-      continue;
     }
     // Too few shared rooms: the walls the merge lays on each other, each peer wall with the own
-    // wall it overlaps longest.
+    // wall it overlaps longest (tied in the walls modes; for the priors in every mode).
     for (const DistilledWall& B : p.graph.walls) {
       const DistilledWall* best = nullptr;
       double best_overlap = config.wall_pair_min_overlap_m;
