@@ -12,7 +12,6 @@
 
 #include <cstdio>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -99,14 +98,13 @@ TEST(CollabSim, TheDemoMissionMergesEveryViewAndNeverWrongly) {
 // priors (they were collected only in the walls modes, so "Rooms" silently ran without
 // feedback), and --feedback off leaves every own map without them.
 std::size_t PriorsOfRobot(const std::string& text, int robot) {
-  const std::regex line("feedback \\((on|off)\\): wall priors from peers[^\\n]*");
-  std::smatch m;
-  if (!std::regex_search(text, m, line)) return static_cast<std::size_t>(-1);
-  const std::regex entry("robot " + std::to_string(robot) + " ([0-9]+) \\(refused");
-  std::smatch e;
-  const std::string found = m.str();
-  if (!std::regex_search(found, e, entry)) return static_cast<std::size_t>(-1);
-  return static_cast<std::size_t>(std::stoul(e[1].str()));
+  constexpr auto kAbsent = static_cast<std::size_t>(-1);
+  const std::size_t line = text.find("wall priors from peers in each local S-Graph");
+  if (line == std::string::npos) return kAbsent;
+  const std::string entry = " robot " + std::to_string(robot) + " ";
+  const std::size_t at = text.find(entry, line);
+  if (at == std::string::npos || at > text.find('\n', line)) return kAbsent;
+  return static_cast<std::size_t>(std::stoul(text.substr(at + entry.size())));
 }
 
 TEST(CollabSim, TheRoomsModeFeedsMatchedWallsBackAndFeedbackOffFeedsNone) {
@@ -128,11 +126,14 @@ TEST(CollabSim, TheRoomsModeFeedsMatchedWallsBackAndFeedbackOffFeedsNone) {
   };
   const std::string on = collab("on");
   ASSERT_NE(on.find("robot 1 merged 2 of 2 robots"), std::string::npos) << on;
+  constexpr auto kAbsent = static_cast<std::size_t>(-1);
+  ASSERT_NE(PriorsOfRobot(on, 1), kAbsent) << on;
+  ASSERT_NE(PriorsOfRobot(on, 2), kAbsent) << on;
   EXPECT_GT(PriorsOfRobot(on, 1), 0u) << on;
   EXPECT_GT(PriorsOfRobot(on, 2), 0u) << on;
-  EXPECT_NE(PriorsOfRobot(on, 1), static_cast<std::size_t>(-1));
   const std::string off = collab("off");
   ASSERT_NE(off.find("robot 1 merged 2 of 2 robots"), std::string::npos) << off;
+  ASSERT_NE(PriorsOfRobot(off, 1), kAbsent) << off;
   EXPECT_EQ(PriorsOfRobot(off, 1), 0u) << off;
   EXPECT_EQ(PriorsOfRobot(off, 2), 0u) << off;
   std::filesystem::remove_all(run);
