@@ -14,6 +14,7 @@
 #include "msgraphs/base/byte_order.hpp"
 #include "msgraphs/base/crc32.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
+#include "msgraphs/core/collab/feedback_gate.hpp"
 #include "msgraphs/core/collab/distilled_codec.hpp"
 #include "msgraphs/core/collab/distiller.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
@@ -524,6 +525,43 @@ TEST(CollaborativeGraph, ACorridorIsTiedAcrossItsAxisOnly) {
   ASSERT_TRUE(g.Solve());
   EXPECT_LT(std::fabs(across.dot((g.room_centre(*cb) - g.room_centre(*ca)).head<2>())), 0.05);
   EXPECT_GT((g.T_self_robot(2).translation() - truth.translation()).norm(), 0.05) << "robot 2 moved";
+}
+
+// The feedback gate (feedback_gate.hpp): a prior that matches the own wall within the summed
+// covariances passes the chi-square 99 % bound for 3 degrees of freedom; one shifted or turned
+// by several sigmas, or facing the other way, does not.
+TEST(FeedbackGate, APriorPassesWithinItsCovariancesOnly) {
+  DistilledWall own;
+  own.normal = Eigen::Vector3d(1, 0, 0);
+  own.d = -2.0;
+  own.covariance = Eigen::Vector3d(1e-6, 1e-6, 1e-4).asDiagonal();  // 1 mrad, 1 cm
+  PlanePrior prior;
+  prior.normal = own.normal;
+  prior.d = own.d;
+  prior.covariance = Eigen::Vector3d(25e-6, 25e-6, 1e-4).asDiagonal();  // 5 mrad, 1 cm
+  const double bound = CollabSessionConfig{}.feedback_gate_chi2;
+  EXPECT_NEAR(PriorDisagreement(prior, own), 0.0, 1e-12);
+  // 2 cm along the normal against a summed sigma of 1.41 cm: 2.0 squared sigmas.
+  prior.d = own.d + 0.02;
+  EXPECT_NEAR(PriorDisagreement(prior, own), 2.0, 1e-9);
+  EXPECT_LE(PriorDisagreement(prior, own), bound);
+  // 10 cm: 50, a wall the origin put elsewhere.
+  prior.d = own.d + 0.10;
+  EXPECT_GT(PriorDisagreement(prior, own), bound);
+  // Turned by 1.6 degrees about the vertical (the wrong view's yaw) against 5.1 mrad: gated.
+  prior.d = own.d;
+  prior.normal = Eigen::AngleAxisd(1.6 * M_PI / 180, Eigen::Vector3d::UnitZ()) * own.normal;
+  EXPECT_GT(PriorDisagreement(prior, own), bound);
+  // Turned by 0.2 degrees: within.
+  prior.normal = Eigen::AngleAxisd(0.2 * M_PI / 180, Eigen::Vector3d::UnitZ()) * own.normal;
+  EXPECT_LE(PriorDisagreement(prior, own), bound);
+  // Facing the other way, or a covariance that is not positive definite: never agrees.
+  prior.normal = -own.normal;
+  EXPECT_TRUE(std::isinf(PriorDisagreement(prior, own)));
+  prior.normal = own.normal;
+  prior.covariance = -Eigen::Matrix3d::Identity();
+  own.covariance.setZero();
+  EXPECT_TRUE(std::isinf(PriorDisagreement(prior, own)));
 }
 
 TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {

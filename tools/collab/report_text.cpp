@@ -86,8 +86,8 @@ void RobotLines(const ReportInput& in, std::string& out) {
       in.mission.feedback ? "on" : "off");
   for (const auto& robot : in.mission.robots) {
     const core::LocalMapperStats& s = robot->mapper.stats();
-    Add(out, " robot %d %zu (refused %llu);", robot->id(), s.plane_priors,
-        static_cast<unsigned long long>(s.plane_priors_refused));
+    Add(out, " robot %d %zu (refused %llu, held back disagreeing %zu);", robot->id(), s.plane_priors,
+        static_cast<unsigned long long>(s.plane_priors_refused), robot->session.stats().priors_gated);
   }
   Add(out, "\n");
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "collab_session_impl.hpp"
+#include "msgraphs/core/collab/feedback_gate.hpp"
 
 namespace msgraphs::core {
 namespace {
@@ -136,7 +137,9 @@ void CollabSession::Impl::Solve() {
 
 std::size_t CollabSession::PlanePriors(std::span<PlanePrior> out) const {
   Impl& m = *impl_;
+  const DistilledGraph& mine = m.distiller.graph();
   std::size_t n = 0;
+  m.stats.priors_gated = 0;
   for (const SessionWallPair& q : m.wall_pairs) {
     if (n == out.size()) break;
     const Impl::Peer* p = m.FindPeer(q.peer);
@@ -153,8 +156,14 @@ std::size_t CollabSession::PlanePriors(std::span<PlanePrior> out) const {
     const double fm = m.config.feedback_sigma_floor_m, fr = m.config.feedback_sigma_floor_rad;
     prior.covariance = m.config.feedback_inflation * B->covariance;
     prior.covariance.diagonal() += Eigen::Vector3d(fr * fr, fr * fr, fm * fm);
+    const DistilledWall* A = mine.FindWall(q.own_wall);
+    if (A != nullptr && m.config.feedback_gate_chi2 > 0 && PriorDisagreement(prior, *A) > m.config.feedback_gate_chi2) {
+      ++m.stats.priors_gated;
+      continue;
+    }
     ++n;
   }
+  m.stats.priors_fed = n;
   return n;
 }
 

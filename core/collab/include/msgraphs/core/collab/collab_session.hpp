@@ -108,6 +108,14 @@ struct CollabSessionConfig {
   double feedback_inflation = 2.0;
   double feedback_sigma_floor_m = 0.01;
   double feedback_sigma_floor_rad = 0.005;
+  /// A prior is fed back only while it agrees with this robot's own wall: the squared
+  /// Mahalanobis distance of their difference (angle, angle, offset) under the two covariances
+  /// summed stays within this bound, the chi-square 99 % quantile for 3 degrees of freedom.
+  /// A prior beyond it says the origin it went through is off by more than the covariances
+  /// allow (they do not hold the origin's own uncertainty); fed back, it bends the own map
+  /// towards the error, the bent map goes out at the next exchange, and the peer's estimate
+  /// follows it (docs/multi-robot.md, the ablation). 0 feeds every prior.
+  double feedback_gate_chi2 = 11.345;
   DistillerConfig distiller;
   RoomDescriptorConfig descriptor;
   RoomMatchConfig matcher;
@@ -183,6 +191,8 @@ struct CollabSessionStats {
                 descriptors_refused = 0, pending_refused = 0, matches_refused = 0,
                 cache_evictions = 0, descriptors_mismatched = 0, encode_failures = 0,
                 clouds_unsolicited = 0, wall_pairs_refused = 0;
+  /// At the last PlanePriors call: priors written, and those held back by feedback_gate_chi2.
+  std::size_t priors_fed = 0, priors_gated = 0;
   /// Walls and rooms the collaborative graph could not hold at the last solve (its capacity, or
   /// a non-finite element).
   std::uint64_t graph_refused = 0;
