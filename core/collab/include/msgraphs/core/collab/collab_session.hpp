@@ -259,7 +259,9 @@ class CollabSession {
   const CollaborativeGraph& collaborative_graph() const;
   /// Other robots' measurements of this robot's matched walls, through the merged origins: the
   /// priors that feed the collaborative estimate back into the local S-Graph
-  /// (LocalMapper::SetPlanePriors). Returns how many were written into `out`.
+  /// (LocalMapper::SetPlanePriors). Those that disagree with the own wall beyond
+  /// feedback_gate_chi2 are held back and counted (stats().priors_gated). Returns how many were
+  /// written into `out`.
   std::size_t PlanePriors(std::span<PlanePrior> out) const;
 
   /// Merge decisions with sequence > `after`, oldest first, into `out`; returns how many. The log
