@@ -12,9 +12,6 @@
 #include "msgraphs/core/collab/feedback_gate.hpp"
 
 namespace msgraphs::core {
-namespace {
-
-}  // namespace
 
 void CollabSession::Impl::Solve() {
   graph.Clear();
@@ -163,7 +160,6 @@ std::size_t CollabSession::PlanePriors(std::span<PlanePrior> out) const {
     }
     ++n;
   }
-  m.stats.priors_fed = n;
   return n;
 }
 

@@ -191,8 +191,9 @@ struct CollabSessionStats {
                 descriptors_refused = 0, pending_refused = 0, matches_refused = 0,
                 cache_evictions = 0, descriptors_mismatched = 0, encode_failures = 0,
                 clouds_unsolicited = 0, wall_pairs_refused = 0;
-  /// At the last PlanePriors call: priors written, and those held back by feedback_gate_chi2.
-  std::size_t priors_fed = 0, priors_gated = 0;
+  /// At the last PlanePriors call: priors held back by feedback_gate_chi2 (those written are
+  /// its return value).
+  std::size_t priors_gated = 0;
   /// Walls and rooms the collaborative graph could not hold at the last solve (its capacity, or
   /// a non-finite element).
   std::uint64_t graph_refused = 0;
