@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: arbitrary bytes as another robot's message. The first byte picks the kind
-// (distilled graph, room descriptor, room cloud request, room cloud, free-space summary); the rest
+// (distilled graph, room descriptor, room cloud request, room cloud, free-space summary, place
+// request, place cloud); the rest
 // is the message body,
 // to which the correct CRC-32 is appended so that the parsers past the checksum are exercised (a
 // wrong CRC alone is rejected at once). Invariants: no crash; whatever decodes is finite, within
 // the receiver's capacity, with unit wall normals, and merges into a copy; a free-space summary
-// that decodes fills exactly its grid with valid states and finite openings.
+// that decodes fills exactly its grid with valid states and finite openings; a place request
+// has distinct robots, a finite centre and a radius in range; a place cloud's points are finite.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -13,6 +15,7 @@
 
 #include "msgraphs/core/collab/distilled_codec.hpp"
 #include "msgraphs/core/collab/free_space_codec.hpp"
+#include "msgraphs/core/collab/place_messages.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
 #include "sealed_message.hpp"
 
@@ -23,7 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::vector<std::uint8_t> message = SealedMessage(std::span(data + 1, size - 1));
   const std::span<const std::uint8_t> bytes(message);
-  switch (data[0] % 5) {
+  switch (data[0] % 7) {
     case 0: {
       static DistilledGraph known, out;
       static bool init = false;
@@ -78,6 +81,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (!o.a.allFinite() || !o.b.allFinite()) std::abort();
       }
       if (!(summary.clearance_m(summary.origin_m()) >= 0.0f)) std::abort();
+      break;
+    }
+    case 5: {
+      auto q = DecodePlaceRequest(bytes);
+      if (q && (q->from == 0 || q->to == 0 || q->from == q->to || !q->centre_m.allFinite() ||
+                !(q->radius_m > 0 && q->radius_m <= kMaxPlaceRadiusM)))
+        std::abort();
+      break;
+    }
+    case 6: {
+      static BoundedVector<Eigen::Vector3f> points(4096);
+      auto h = DecodePlaceCloud(bytes, points);
+      if (!h) break;
+      if (h->robot == 0 || h->to == 0 || h->robot == h->to || !h->centre_m.allFinite() || points.size() > 4096)
+        std::abort();
+      for (const Eigen::Vector3f& p : points) {
+        if (!p.allFinite()) std::abort();
+      }
       break;
     }
     default: {

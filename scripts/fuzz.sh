@@ -60,6 +60,10 @@ cloud = b'MSRC' + struct.pack('<BBHIIfI', 1, 1, 2, 3, 2, 0.01, 2) + struct.pack(
 open(f"{d}/cloud", 'wb').write(b'\x03' + cloud)
 request = b'MSRQ' + struct.pack('<BHHII', 1, 2, 1, 3, 2)
 open(f"{d}/request", 'wb').write(b'\x02' + request)
+place_request = b'MSPQ' + struct.pack('<BHHIfffI', 1, 2, 1, 3, 4.0, -2.0, 5.0, 0)
+open(f"{d}/place_request", 'wb').write(b'\x05' + place_request)
+place_cloud = b'MSPC' + struct.pack('<BHHIffffI', 1, 2, 1, 3, 4.0, -2.0, -0.5, 0.04, 2) + bytes([1, 2, 30, 250, 251, 20])
+open(f"{d}/place_cloud", 'wb').write(b'\x06' + place_cloud)
 PY
 cp "$WORK"/collab_messages/* "$WORK/collab_session/"
 

@@ -86,6 +86,12 @@ bool ParseOptions(int argc, char** argv, Options& o, std::string& error) {
       if (!Number(v, number) || !(number > 0)) return fail(a + " takes metres > 0");
       o.session.cloud_step_m = static_cast<float>(number);
       step_given = true;
+    } else if (a == "--places") {
+      // The merge decision's fallback (place_evidence.hpp): on with the session's byte budget
+      // per peer, off to measure what it adds.
+      const std::string f = v;
+      if (f != "on" && f != "off") return fail("--places is on or off");
+      if (f == "off") o.session.places.budget_bytes_per_peer = 0;
     } else if (a == "--feedback") {
       const std::string f = v;
       if (f != "on" && f != "off") return fail("--feedback is on or off");

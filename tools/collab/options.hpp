@@ -31,6 +31,7 @@ inline constexpr const char* kUsage =
     "usage: msgraphs_collab --run DIR [--mode "
     "rooms|rooms-fine|rooms-walls|rooms-walls-fine|keyframes]\n"
     "                       [--cloud f32|q16|q8] [--cloud-step 0.01] [--feedback on|off]\n"
+    "                       [--places on|off]\n"
     "                       [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]...\n"
     "                       [--wrong-origin-m 0.5]\n"
     "                       [--wrong-origin-deg 2] [--out DIR] [--summary FILE] [--explain DIR]\n"

@@ -29,13 +29,14 @@ std::string PeerStatsLine(int viewer, const core::CollabPeerStats& p, std::size_
 }
 
 std::string SessionStatsLine(int robot, const core::CollabSessionStats& st) {
-  char b[640];
+  char b[1024];
   std::snprintf(
       b, sizeof b,
       "robot %d session: %zu own rooms (peak room cloud %zu points), %zu peers, stores %.1f MB; "
       "refused: rooms %llu, clouds too large %llu, descriptors %llu, pending %llu, matches %llu; "
       "cache evictions %llu; solves %llu (%llu failed); marginal wall covariances %llu times "
-      "(%llu fell back)\n",
+      "(%llu fell back); places: %llu asked, %llu received, %llu served, %llu refused, %llu "
+      "unanswered, %llu unsolicited; %llu decisions weighed on them, %llu transforms set aside\n",
       robot, st.own_rooms, st.room_points_peak, st.peers, static_cast<double>(st.store_bytes) / 1e6,
       static_cast<unsigned long long>(st.rooms_refused),
       static_cast<unsigned long long>(st.room_clouds_too_large),
@@ -46,7 +47,14 @@ std::string SessionStatsLine(int robot, const core::CollabSessionStats& st) {
       static_cast<unsigned long long>(st.solves),
       static_cast<unsigned long long>(st.solve_failures),
       static_cast<unsigned long long>(st.marginal_updates),
-      static_cast<unsigned long long>(st.marginal_failures));
+      static_cast<unsigned long long>(st.marginal_failures),
+      static_cast<unsigned long long>(st.place_requests_sent),
+      static_cast<unsigned long long>(st.place_clouds_received),
+      static_cast<unsigned long long>(st.place_requests_served),
+      static_cast<unsigned long long>(st.place_requests_refused),
+      static_cast<unsigned long long>(st.place_requests_unanswered),
+      static_cast<unsigned long long>(st.place_clouds_unsolicited),
+      static_cast<unsigned long long>(st.place_duels), static_cast<unsigned long long>(st.place_set_aside));
   return b;
 }
 
@@ -71,6 +79,8 @@ void WritePeerStats(JsonWriter& json, const core::CollabPeerStats& p) {
   json.Field("rival_agreement_m", p.rival.agreement_m);
   json.Field("rival_constraint_m", p.rival.constraint_m);
   json.Field("rival_conflict_m", p.rival.conflict_m);
+  json.Field("set_aside", p.set_aside);
+  json.Field("places", p.places);
   json.Field("merges", p.merges);
   json.Field("revised", p.revised);
   json.Field("undone", p.undone);

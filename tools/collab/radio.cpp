@@ -6,14 +6,16 @@ namespace msgraphs::tools::collab {
 const char* MessageTypeName(int type) {
   static constexpr const char* kNames[kMessageTypes] = {"distilled graph",      "room descriptors",
                                                         "room cloud requests",  "room clouds",
-                                                        "free space",           "keyframe descriptors", "keyframe clouds"};
+                                                        "free space",           "place requests",
+                                                        "place clouds",         "keyframe descriptors", "keyframe clouds"};
   return type >= 0 && type < kMessageTypes ? kNames[type] : "unknown";
 }
 
 const char* MessageTypeKey(int type) {
   static constexpr const char* kKeys[kMessageTypes] = {"distilled_graph",      "room_descriptors",
                                                        "room_cloud_requests",  "room_clouds",
-                                                       "free_space",           "keyframe_descriptors", "keyframe_clouds"};
+                                                       "free_space",           "place_requests",
+                                                       "place_clouds",         "keyframe_descriptors", "keyframe_clouds"};
   return type >= 0 && type < kMessageTypes ? kKeys[type] : "unknown";
 }
 

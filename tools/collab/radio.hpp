@@ -15,7 +15,7 @@
 
 namespace msgraphs::tools::collab {
 
-/// The session's five message types (same values as core::CollabMessageType), then the
+/// The session's seven message types (same values as core::CollabMessageType), then the
 /// keyframe-level baseline's two.
 enum MessageType {
   kGraph,
@@ -23,11 +23,14 @@ enum MessageType {
   kCloudRequest,
   kCloud,
   kFreeSpace,
+  kPlaceRequest,
+  kPlaceCloud,
   kKeyframeDescriptor,
   kKeyframeCloud,
   kMessageTypes
 };
 static_assert(kFreeSpace == static_cast<int>(core::CollabMessageType::kFreeSpace) &&
+              kPlaceCloud == static_cast<int>(core::CollabMessageType::kPlaceCloud) &&
               kKeyframeDescriptor == core::kCollabMessageTypes);
 /// "distilled graph", ... (reports, bytes.csv columns).
 const char* MessageTypeName(int type);

@@ -43,6 +43,7 @@ void WriteOptions(JsonWriter& json, const Options& o) {
   json.Field("cloud", o.cloud_name);
   json.Field("cloud_step_m", static_cast<double>(o.session.cloud_step_m));
   json.Field("feedback", o.feedback);
+  json.Field("places", o.session.places.budget_bytes_per_peer > 0);
   json.Field("exchange_every_s", o.every_s);
   json.Field("wrong_origin_m", o.evaluation.wrong_origin_m);
   json.Field("wrong_origin_deg", o.evaluation.wrong_origin_deg);

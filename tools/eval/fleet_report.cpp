@@ -373,11 +373,16 @@ int main(int argc, char** argv) {
         st("matches_accepted"), rejected, st("matches_rejected_fine"),
         st("matches_rejected_anchored"), st("matches_rejected_consistency"),
         st("matches_proposed"));
-    Say(report, "  sent: graph %s, descriptors %s, cloud requests %s, room clouds %s (%s in all)\n",
+    Say(report,
+        "  sent: graph %s, descriptors %s, cloud requests %s, room clouds %s, free space %s, place "
+        "requests %s, place clouds %s (%s in all)\n",
         Kb(st("sent_graph_bytes")).c_str(), Kb(st("sent_descriptors_bytes")).c_str(),
         Kb(st("sent_requests_bytes")).c_str(), Kb(st("sent_clouds_bytes")).c_str(),
+        Kb(st("sent_free_space_bytes")).c_str(), Kb(st("sent_place_requests_bytes")).c_str(),
+        Kb(st("sent_place_clouds_bytes")).c_str(),
         Kb(st("sent_graph_bytes") + st("sent_descriptors_bytes") + st("sent_requests_bytes") +
-           st("sent_clouds_bytes"))
+           st("sent_clouds_bytes") + st("sent_free_space_bytes") + st("sent_place_requests_bytes") +
+           st("sent_place_clouds_bytes"))
             .c_str());
     Say(report,
         "  node: keyframe %.1f ms p50, %.1f ms p99; scan queue peak %.0f, %.0f scans dropped; "

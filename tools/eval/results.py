@@ -244,7 +244,7 @@ def main():
             continue
         for k, r in sorted(f["robots"].items()):
             st = r["stats"]
-            sent = sum(st.get(f"sent_{t}_bytes", 0) for t in ("graph", "descriptors", "requests", "clouds", "free_space")) / 1e3
+            sent = sum(st.get(f"sent_{t}_bytes", 0) for t in ("graph", "descriptors", "requests", "clouds", "free_space", "place_requests", "place_clouds")) / 1e3
             p(f"| {title} | {k} | {st.get('keyframe_p50_ms', 0):.0f} / {st.get('keyframe_p99_ms', 0):.0f} | "
               f"{st.get('peak_rss_mb', 0):.0f} | {sent:.0f} | {r['walls']} / {r['rooms']} | {r['merged']} of {r['peers']} | {r['ate_cm']:.1f} |")
         if f["view"]:

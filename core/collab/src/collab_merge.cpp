@@ -70,6 +70,8 @@ void CollabSession::Impl::Log(const Peer& p, MergeEvent event) {
   e.symmetric = d.symmetric;
   e.hypotheses = d.hypotheses;
   e.refuted = d.refuted;
+  e.set_aside = d.set_aside;
+  e.places = d.places;
   ++stats.log_entries;
 }
 
@@ -77,7 +79,7 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
   const std::uint32_t own_version = distiller.graph().version;
   if (p.decided_once && p.decided_own == own_version && p.decided_peer == p.graph.version &&
       p.decided_own_free == own_free_version && p.decided_free == p.free_version &&
-      p.decided_matches == p.matches.size()) {
+      p.decided_matches == p.matches.size() && p.decided_places == p.places_version) {
     return false;
   }
   p.decided_once = true;
@@ -86,6 +88,7 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
   p.decided_own_free = own_free_version;
   p.decided_free = p.free_version;
   p.decided_matches = p.matches.size();
+  p.decided_places = p.places_version;
   ++stats.decisions;
 
   const MergeVerdict before = p.decision.verdict;
@@ -112,6 +115,8 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
     in.sym_b = p.symmetries.span();
     in.channels = search.channels();
     d = DecideMerge(in, search, config.merge, p.merged ? &p.T_merge : nullptr);
+    // Undecided between two transforms: the points of the places held may tell them apart.
+    WeighPlaces(p, in, d);
   }
   const double same_m = config.search.same_distance_m, same_rad = config.search.same_angle_rad;
   // Confirmation: a new merge, or a move to another transform, needs the same leader to win
@@ -201,6 +206,8 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
   s.rival_from_symmetry = d.rival_from_symmetry;
   s.leader = d.has_leader ? Evidence(d.leader) : MergeEvidence{};
   s.rival = d.has_rival ? Evidence(d.rival) : MergeEvidence{};
+  s.set_aside = d.set_aside;
+  s.places = d.places;
   // The room matches the merge agrees with.
   p.consistent_count = 0;
   if (p.merged) {

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "msgraphs/core/collab/collab_session.hpp"
+#include "msgraphs/core/collab/place_decision.hpp"
+#include "msgraphs/core/collab/place_messages.hpp"
 
 namespace msgraphs::core {
 
@@ -29,6 +31,15 @@ struct SessionPending {
   std::uint32_t own_room = 0, own_version = 0, peer_room = 0, peer_version = 0;
   float sc_distance = 1, yaw_rad = 0;
   std::uint64_t requested_call = 0;
+};
+
+// A peer's place cloud held for the fallback (collab_places.cpp).
+struct SessionHeldPlace {
+  bool used = false;
+  std::uint32_t place = 0;
+  Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  // the peer's map frame
+  std::uint64_t stamp = 0;
+  BoundedVector<Eigen::Vector3f> points;  // relative to the centre and the peer's floor
 };
 
 struct CollabSession::Impl {
@@ -104,6 +115,19 @@ struct CollabSession::Impl {
     // Its constraint (metres of wall on wall in its weakest direction) when it last counted: a
     // confirmation needs more.
     double pending_constraint_m = 0;
+    // The fallback (collab_places.cpp): its place clouds, the places asked for, the request
+    // outstanding, the bytes each way, and the two transforms the last decision could not
+    // tell apart (a place is asked for them).
+    std::vector<SessionHeldPlace> places;
+    std::uint32_t places_version = 0, decided_places = 0;
+    BoundedVector<Eigen::Vector2d> places_asked;
+    bool place_pending = false, wants_place = false;
+    std::uint32_t place_pending_id = 0, place_tries = 0, next_place = 0;
+    std::uint64_t place_requested_call = 0;
+    std::uint64_t place_bytes_in = 0, place_bytes_out = 0;
+    bool place_served = false;  // the last place this peer asked for was answered
+    std::uint32_t place_served_id = 0;
+    PlanarTransform duel_first, duel_second;
     std::uint32_t solved_version = 0;  // its graph's version at the last solve
     Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();
     CollabPeerStats stats;
@@ -134,6 +158,15 @@ struct CollabSession::Impl {
   AlignmentSearch symmetry_search;  // one map with itself
   BoundedVector<PlanarTransform> seeds;
   bool solve_needed = false;
+  // The fallback: requests from peers awaiting the next Publish, the builder, the scorer.
+  BoundedVector<PlaceRequest> place_queue;
+  PlaceCloudBuilder place_builder;
+  PlaceScorer place_scorer;
+  PlaceChooser place_chooser;
+  BoundedVector<Eigen::Vector3f> place_scratch;
+  BoundedVector<PlanarTransform> set_aside;
+  std::vector<PlaceView> place_views;  // the held places of one peer, for a decision
+  std::uint64_t place_clock = 0;
 
   Peer* FindPeer(std::uint16_t robot) {
     for (Peer& p : peers) {
@@ -187,6 +220,12 @@ struct CollabSession::Impl {
   void Log(const Peer& p, MergeEvent event);
   // collab_solve.cpp
   void Solve();
+  // collab_places.cpp
+  Status ReceivePlaceRequest(std::span<const std::uint8_t> bytes);
+  Status ReceivePlaceCloud(std::span<const std::uint8_t> bytes);
+  void ServePlaces(const LocalMapper& mapper, CollabOutbox& out);
+  void WeighPlaces(Peer& p, MergeInputs& in, MergeDecision& d);
+  void AskForPlace(Peer& p, CollabOutbox& out);
 };
 
 }  // namespace msgraphs::core

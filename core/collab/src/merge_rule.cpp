@@ -11,6 +11,14 @@ namespace {
 bool Standing(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.RefuteLimit(h); }
 bool StillStanding(const Hypothesis& h, const MergeRuleConfig& c) { return h.conflict_m() <= c.UndoLimit(h); }
 
+// Set aside by point-level evidence (MergeInputs::set_aside).
+bool SetAside(const MergeInputs& in, const PlanarTransform& T, double same_m, double same_rad) {
+  for (const PlanarTransform& s : in.set_aside) {
+    if (SameTransform(T, s, same_m, same_rad)) return true;
+  }
+  return false;
+}
+
 bool Beats(const Hypothesis& leader, const Hypothesis& rival, double ratio, const MergeRuleConfig& c) {
   return leader.agreement.agreement_m >= ratio * rival.agreement.agreement_m + c.margin_m;
 }
@@ -169,6 +177,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
   }
   if (!keeping) {
     for (std::size_t i = 0; i < in.hypotheses.size() && leader < 0; ++i) {
+      if (SetAside(in, in.hypotheses[i].T_a_b, same_m, same_rad)) continue;
       MeasureConflict(in.hypotheses[i], in, cc);
       if (Standing(in.hypotheses[i], c)) leader = static_cast<int>(i);
     }
@@ -219,7 +228,9 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     }
     for (int i = 0; i < leader; ++i) {
       const Hypothesis& h = in.hypotheses[static_cast<std::size_t>(i)];
-      if (!h.conflict_known || Standing(h, c) || SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) continue;
+      if (!h.conflict_known || Standing(h, c) || SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad) ||
+          SetAside(in, h.T_a_b, same_m, same_rad))
+        continue;
       const bool stronger_both = Beats(h, L, c.margin_ratio, c) &&
                                  h.agreement.constraint_m >= c.margin_ratio * L.agreement.constraint_m + c.margin_m;
       const bool stronger_net =
@@ -238,7 +249,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
   auto consider = [&](const PlanarTransform& T) {
     if (SameTransform(T, L.T_a_b, same_m, same_rad)) return;
     Hypothesis h = search.Evaluate(*in.walls_a, *in.walls_b, T);
-    if (SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) return;
+    if (SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad) || SetAside(in, h.T_a_b, same_m, same_rad)) return;
     if (h.agreement.constraint_m < c.min_rival_constraint_m) return;
     MeasureConflict(h, in, cc);
     if (!Standing(h, c)) return;
@@ -278,7 +289,7 @@ MergeDecision DecideMerge(MergeInputs& in, const AlignmentSearch& search, const 
     if (static_cast<int>(i) == leader) continue;
     Hypothesis& h = in.hypotheses[i];
     if (h.agreement.constraint_m < c.min_rival_constraint_m) continue;
-    if (SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad)) continue;
+    if (SameTransform(h.T_a_b, L.T_a_b, same_m, same_rad) || SetAside(in, h.T_a_b, same_m, same_rad)) continue;
     // Below what could block even at the wider margin: no later one can either.
     if (h.agreement.agreement_m * c.symmetric_margin_ratio + c.margin_m <= L.agreement.agreement_m) break;
     MeasureConflict(h, in, cc);

@@ -40,11 +40,14 @@ namespace {
 constexpr int kTelemetry = core::kCollabMessageTypes;  // index of the telemetry topic's stats
 constexpr const char* kTopicNames[core::kCollabMessageTypes + 1] = {
     "msgraphs/graph", "msgraphs/room_descriptor", "msgraphs/room_cloud_request",
-    "msgraphs/room_cloud", "msgraphs/free_space", "msgraphs/telemetry"};
+    "msgraphs/room_cloud", "msgraphs/free_space", "msgraphs/place_request", "msgraphs/place_cloud",
+    "msgraphs/telemetry"};
 // Flow controller priorities (-10 highest): liveness first, then what unblocks a peer's
 // matching, then state, then bulk.
-constexpr const char* kPriorities[core::kCollabMessageTypes + 1] = {"0", "2", "-5", "5", "3", "-10"};
+constexpr const char* kPriorities[core::kCollabMessageTypes + 1] = {"0", "2", "-5", "5", "3", "-5", "5", "-10"};
 constexpr int kFreeSpaceTopic = static_cast<int>(core::CollabMessageType::kFreeSpace);
+constexpr int kPlaceRequestTopic = static_cast<int>(core::CollabMessageType::kPlaceRequest);
+constexpr int kPlaceCloudTopic = static_cast<int>(core::CollabMessageType::kPlaceCloud);
 constexpr const char* kFlowController = "msgraphs_radio";
 constexpr const char* kParticipantPrefix = "msgraphs_robot_";
 
@@ -187,6 +190,8 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
   idl::RoomCloudRequestSample out_request, in_request;
   idl::RoomCloudSample out_cloud, in_cloud;
   idl::FreeSpaceSample out_free, in_free;
+  idl::PlaceRequestSample out_place_request, in_place_request;
+  idl::PlaceCloudSample out_place_cloud, in_place_cloud;
 
   ~Impl() override {
     if (participant == nullptr) return;
@@ -377,6 +382,28 @@ struct FleetLink::Impl final : dds::DomainParticipantListener {
             out.to = in_cloud.addressee();
           }
           break;
+        case core::CollabMessageType::kPlaceRequest:
+          if (reader->take_next_sample(&in_place_request, &info) != ReturnCode_t::RETCODE_OK) return false;
+          if (!info.valid_data) continue;
+          admitted = Admit(t, info, in_place_request.version(), in_place_request.robot_id(),
+                           in_place_request.addressee(), in_place_request.payload());
+          if (admitted) {
+            copy(in_place_request.payload());
+            out.from = in_place_request.robot_id();
+            out.to = in_place_request.addressee();
+          }
+          break;
+        case core::CollabMessageType::kPlaceCloud:
+          if (reader->take_next_sample(&in_place_cloud, &info) != ReturnCode_t::RETCODE_OK) return false;
+          if (!info.valid_data) continue;
+          admitted = Admit(t, info, in_place_cloud.version(), in_place_cloud.robot_id(),
+                           in_place_cloud.addressee(), in_place_cloud.payload());
+          if (admitted) {
+            copy(in_place_cloud.payload());
+            out.from = in_place_cloud.robot_id();
+            out.to = in_place_cloud.addressee();
+          }
+          break;
         case core::CollabMessageType::kFreeSpace:
           if (reader->take_next_sample(&in_free, &info) != ReturnCode_t::RETCODE_OK) return false;
           if (!info.valid_data) continue;
@@ -423,6 +450,10 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
       dds::TypeSupport(new CountingType<idl::RoomCloudSamplePubSubType>(&impl->undecodable[3]));
   impl->types[kFreeSpaceTopic] =
       dds::TypeSupport(new CountingType<idl::FreeSpaceSamplePubSubType>(&impl->undecodable[kFreeSpaceTopic]));
+  impl->types[kPlaceRequestTopic] = dds::TypeSupport(
+      new CountingType<idl::PlaceRequestSamplePubSubType>(&impl->undecodable[kPlaceRequestTopic]));
+  impl->types[kPlaceCloudTopic] = dds::TypeSupport(
+      new CountingType<idl::PlaceCloudSamplePubSubType>(&impl->undecodable[kPlaceCloudTopic]));
   impl->types[kTelemetry] =
       dds::TypeSupport(new CountingType<idl::TelemetryPubSubType>(&impl->undecodable[kTelemetry]));
   impl->publisher = impl->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
@@ -449,8 +480,8 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
         state ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
     w.history().kind = dds::KEEP_LAST_HISTORY_QOS;
     w.history().depth = t == 0   ? static_cast<std::int32_t>(settings.graph_history)
-                        : t == 2 ? 16
-                        : t == 3 ? 8
+                        : t == 2 || t == kPlaceRequestTopic ? 16
+                        : t == 3 || t == kPlaceCloudTopic   ? 8
                                  : 1;
     // Descriptors: one instance per own room; telemetry, graph and free space: one instance
     // (this robot).
@@ -503,6 +534,8 @@ Expected<std::unique_ptr<FleetLink>> FleetLink::Create(RobotId self, const LinkS
   impl->out_request.robot_id(id);
   impl->out_cloud.robot_id(id);
   impl->out_free.robot_id(id);
+  impl->out_place_request.robot_id(id);
+  impl->out_place_cloud.robot_id(id);
   return std::unique_ptr<FleetLink>(new FleetLink(std::move(impl)));
 }
 
@@ -554,6 +587,16 @@ void FleetLink::Send(core::CollabMessageType type,
         ok = m.writers[t]->write(&m.out_cloud);
         break;
       }
+      case core::CollabMessageType::kPlaceRequest:
+        fill(m.out_place_request);
+        m.out_place_request.addressee(to);
+        ok = m.writers[t]->write(&m.out_place_request);
+        break;
+      case core::CollabMessageType::kPlaceCloud:
+        fill(m.out_place_cloud);
+        m.out_place_cloud.addressee(to);
+        ok = m.writers[t]->write(&m.out_place_cloud);
+        break;
       case core::CollabMessageType::kFreeSpace: {
         fill(m.out_free);
         auto header = core::PeekFreeSpaceHeader(bytes);

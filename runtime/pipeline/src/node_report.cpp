@@ -222,7 +222,8 @@ void Node::Impl::PrintReport() {
             cs.accepted);
     Appendf(stats, "merge_decisions %" PRIu64 "\nmerges %" PRIu64 "\nmerges_revised %" PRIu64
             "\nmerges_undone %" PRIu64 "\n", cs.decisions, cs.merges, cs.revised, cs.undone);
-    const char* kinds[] = {"graph", "descriptors", "requests", "clouds", "free_space"};
+    const char* kinds[core::kCollabMessageTypes] = {"graph", "descriptors", "requests", "clouds",
+                                                   "free_space", "place_requests", "place_clouds"};
     for (int k = 0; k < core::kCollabMessageTypes; ++k) {
       Appendf(stats, "sent_%s_bytes %" PRIu64 "\nreceived_%s_bytes %" PRIu64 "\n", kinds[k],
               cs.bytes_sent[k], kinds[k], received[k]);

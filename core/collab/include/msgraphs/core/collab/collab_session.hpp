@@ -15,6 +15,10 @@
 //   the free space each robot saw, kept only without a standing rival), logs every change of
 //   decision with its evidence and rivals (MergeLog), and solves the collaborative graph when a
 //   merge or a merged map changed. A merge that later evidence contradicts is undone.
+// - The fallback (place_evidence.hpp): a pair the rule leaves undecided between two transforms
+//   asks the peer for its points around a place that tells them apart, within a byte budget
+//   per peer; the points set the loser aside. A peer's place request is queued and answered
+//   at the next Publish (it needs the map).
 //
 // Bounded: every store is sized at Init (capacities in CollabSessionConfig; the byte figure is
 // in stats()); what allocates after Init is Ceres, in Publish's wall marginals (Distiller) and
@@ -34,6 +38,8 @@
 #include "msgraphs/core/collab/distiller.hpp"
 #include "msgraphs/core/collab/free_space_summary.hpp"
 #include "msgraphs/core/collab/merge_rule.hpp"
+#include "msgraphs/core/collab/place_cloud.hpp"
+#include "msgraphs/core/collab/place_evidence.hpp"
 #include "msgraphs/core/collab/room_descriptor.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
@@ -48,8 +54,10 @@ enum class CollabMessageType : std::uint8_t {
   kRoomCloudRequest = 2,
   kRoomCloud = 3,
   kFreeSpace = 4,  ///< the free-space summary (free_space_codec.hpp)
+  kPlaceRequest = 5,  ///< the merge decision's fallback (place_messages.hpp)
+  kPlaceCloud = 6,
 };
-inline constexpr int kCollabMessageTypes = 5;
+inline constexpr int kCollabMessageTypes = 7;
 const char* CollabMessageTypeName(CollabMessageType type);
 
 /// The paper's ablation modes.
@@ -124,6 +132,9 @@ struct CollabSessionConfig {
   double free_space_resend_share = 0.02;
   AlignmentSearchConfig search;
   MergeRuleConfig merge;
+  /// The fallback for pairs the rule leaves undecided (place_evidence.hpp).
+  PlaceEvidenceConfig places;
+  PlaceCloudConfig place_cloud;
   /// With fewer than two room matches the merge agrees with, the walls the merge lays on each
   /// other along at least this tie the maps (wall-to-wall factors).
   double wall_pair_min_overlap_m = 1.0;
@@ -156,6 +167,7 @@ struct CollabPeerStats {
   bool undecided = false;  ///< not merged although a leader exists (a rival, too little, ...)
   bool symmetric = false, rival_from_symmetry = false;
   MergeEvidence leader, rival;
+  std::size_t set_aside = 0, places = 0;  ///< the last decision's fallback (MergeDecision)
   std::uint64_t merges = 0, undone = 0, revised = 0;
   double first_merge_s = -1;  ///< the `now_s` of the Match that first merged it (-1: never)
   std::uint64_t bytes_received[kCollabMessageTypes] = {};
@@ -186,6 +198,12 @@ struct CollabSessionStats {
   /// Distillations with marginal wall covariances, and those that fell back to conditional ones.
   std::uint64_t marginal_updates = 0, marginal_failures = 0;
   std::uint64_t requests_sent = 0, requests_served = 0, requests_unknown = 0;
+  /// The fallback: place clouds asked for, received, served; requests refused (a peer's byte
+  /// budget spent, or the queue full), never answered, clouds not asked for; decisions weighed
+  /// on place evidence and the transforms it set aside (place_decision.hpp).
+  std::uint64_t place_requests_sent = 0, place_clouds_received = 0, place_requests_served = 0,
+                place_requests_refused = 0, place_requests_unanswered = 0, place_clouds_unsolicited = 0,
+                place_duels = 0, place_set_aside = 0;
   // Refusals of full stores (see the header comment).
   std::uint64_t peers_refused = 0, rooms_refused = 0, room_clouds_too_large = 0,
                 descriptors_refused = 0, pending_refused = 0, matches_refused = 0,
@@ -219,6 +237,7 @@ struct MergeLogEntry {
   MergeEvidence leader, rival;
   bool has_rival = false, rival_from_symmetry = false, symmetric = false;
   std::size_t hypotheses = 0, refuted = 0;
+  std::size_t set_aside = 0, places = 0;  ///< transforms set aside by place evidence, clouds weighed
 };
 
 class CollabSession {

@@ -153,6 +153,9 @@ struct MergeDecision {
   std::size_t hypotheses = 0, refuted = 0;
   /// Rule 6, measured when the rule would merge anew: each map's walls in its own free space (m).
   double self_conflict_a_m = 0, self_conflict_b_m = 0;
+  /// The fallback (the session's bookkeeping, collab_places.cpp): transforms set aside by place
+  /// evidence for this decision, and the place clouds weighed.
+  std::size_t set_aside = 0, places = 0;
 };
 
 /// Everything the rule looks at for one robot pair. `sym_a`, `sym_b`: the maps' own symmetries
@@ -166,6 +169,9 @@ struct MergeInputs {
   bool truncated = false;
   std::span<const Hypothesis> sym_a, sym_b;
   std::span<const Hypothesis> channels;  ///< AlignmentSearch::channels(): one-direction alignments
+  /// Transforms point-level evidence has set aside (place_evidence.hpp: a duel lost on the
+  /// points of a place): neither leader, nor rival, nor stronger refuted evidence.
+  std::span<const PlanarTransform> set_aside;
 };
 
 /// Decides. `search` evaluates the symmetry alternatives. `current` (optional): the transform

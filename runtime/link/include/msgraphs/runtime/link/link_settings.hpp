@@ -15,7 +15,7 @@ namespace msgraphs::runtime::link {
 
 /// The largest payloads the IDL admits (CollabMessages.idl), by core::CollabMessageType.
 inline constexpr std::array<std::size_t, core::kCollabMessageTypes> kMaxPayloadBytes = {
-    262144, 8192, 64, 1048576, 1048576};
+    262144, 8192, 64, 1048576, 1048576, 64, 65536};
 
 struct LinkSettings {
   DdsSettings dds;
