@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // What a node leaves behind when it stops: its keyframes (TUM), where it placed every other
 // robot (origins.csv), and a report on stdout (and in report.txt).
+#include <array>
 #include <sys/resource.h>
 
 #include <cinttypes>
@@ -149,7 +150,10 @@ void Node::Impl::PrintReport() {
   std::uint64_t rejected[4] = {};
   std::uint64_t lost = 0, write_failures = 0;
   std::string lost_topics;
-  const char* topic_names[] = {"graph", "descriptors", "requests", "clouds", "free space", "telemetry"};
+  // By topic: the collab message types, then telemetry (link::LinkStats::topics).
+  const std::array<const char*, core::kCollabMessageTypes + 1> topic_names = {
+      "graph", "descriptors", "requests", "clouds", "free space", "place requests", "place clouds", "telemetry"};
+  static_assert(std::tuple_size_v<decltype(link::LinkStats::topics)> == topic_names.size());
   for (std::size_t i = 0; i < ls.topics.size(); ++i) {
     if (ls.topics[i].lost == 0) continue;
     lost_topics += std::string(lost_topics.empty() ? " (" : ", ") + topic_names[i] + " " +
