@@ -6,6 +6,7 @@
 
 #include "build_info.hpp"
 #include "modes.hpp"
+#include "msgraphs/core/collab/place_messages.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/realtime.hpp"
@@ -106,6 +107,27 @@ int RunSelfCheck(std::uint32_t domain_id) {
               Percentile(latency_us, 1.0));
   if (lost != 0) {
     std::printf("self-check FAILED: messages lost on a reliable loopback link\n");
+    return 1;
+  }
+  // The merge decision's fallback: a place request robot 1 -> robot 2 and the place cloud back,
+  // on their own topics, intact and typed.
+  std::array<std::uint8_t, core::kPlaceRequestBytes> place_request{};
+  static_cast<void>(core::EncodePlaceRequest({1, 2, 1, {3.0f, -2.0f}, 5.0f}, place_request));
+  const std::array<Eigen::Vector3f, 3> points = {Eigen::Vector3f(0.5f, 0.2f, 1.0f), Eigen::Vector3f(-4.0f, 2.0f, 0.3f),
+                                                 Eigen::Vector3f(1.0f, -3.0f, 1.9f)};
+  std::vector<std::uint8_t> place_cloud(core::PlaceCloudEncodedSize(points.size()));
+  static_cast<void>(core::EncodePlaceCloud({2, 1, 1, {3.0f, -2.0f}, -0.5f, 0.04f}, points, place_cloud));
+  auto round_trip = [&](link::FleetLink& from, link::FleetLink& to, core::CollabMessageType type, std::uint16_t addressee,
+                        std::span<const std::uint8_t> bytes) {
+    from.Send(type, addressee, bytes);
+    return to.Receive(received, Duration::FromMilliseconds(1000)) && received.type == type &&
+           std::equal(received.bytes.begin(), received.bytes.end(), bytes.begin(), bytes.end());
+  };
+  const bool place_ok = round_trip(**a, **b, core::CollabMessageType::kPlaceRequest, 2, place_request) &&
+                        round_trip(**b, **a, core::CollabMessageType::kPlaceCloud, 1, place_cloud);
+  std::printf("  place request robot 1 -> robot 2 and its cloud back: %s\n", place_ok ? "intact" : "LOST or altered");
+  if (!place_ok) {
+    std::printf("self-check FAILED: a place message was lost or altered on a reliable loopback link\n");
     return 1;
   }
   std::printf("self-check passed\n");
