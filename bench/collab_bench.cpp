@@ -3,13 +3,19 @@
 // collab thread runs it for every peer whenever a map or a free space changed. Arg 0: rooms
 // per map (four walls each); arg 1: channels (one-direction alignments, the wall-pair families)
 // on or off.
+// And a place cloud built from a mapped hall (place_cloud.hpp): the fallback's answer to a
+// peer, built in Publish (the node's SLAM thread). Arg 0: keyframes, all within reach of the
+// place (the worst case: a robot that walked the hall back and forth).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <vector>
 
+#include "../tests/core/synthetic_clouds.hpp"
 #include "msgraphs/core/collab/alignment_search.hpp"
+#include "msgraphs/core/collab/place_cloud.hpp"
 #include "msgraphs/core/collab/wall_index.hpp"
+#include "msgraphs/core/slam/local_mapper.hpp"
 
 namespace msgraphs::core {
 namespace {
@@ -61,6 +67,54 @@ void BM_AlignmentSearch(benchmark::State& state) {
 }
 // 250 rooms (1,000 walls, the distiller's capacity) take 18 s a search and truncate: see docs/performance.md.
 BENCHMARK(BM_AlignmentSearch)->Args({25, 0})->Args({25, 1})->Args({100, 0})->Args({100, 1})->Unit(benchmark::kMillisecond);
+
+// A 24 x 16 m hall (3 m high) mapped with perfect odometry, a keyframe a metre, back and forth
+// along its middle third.
+bool MapTheHall(int keyframes, LocalMapper& mapper) {
+  constexpr double kSx = 24.0, kSy = 16.0, kSz = 3.0;
+  LocalMapperConfig config;
+  config.max_scan_points = 25000;
+  config.graph.max_keyframes = static_cast<std::size_t>(keyframes) + 8;
+  config.graph.max_factors = config.graph.max_keyframes * 64;
+  config.cloud_store_points = config.graph.max_keyframes * 12000;
+  if (!mapper.Init(config)) return false;
+  Eigen::Isometry3d T_world_first = test::PlanarPose(8.0, 8.0, 0.0);
+  T_world_first.translation().z() = config.base_height_m;
+  const std::vector<float> times(20000, 0.1f);
+  for (int i = 0; i < keyframes; ++i) {
+    const int leg = (i / 8) % 2, step = i % 8;
+    Eigen::Isometry3d T_world_base = T_world_first;
+    T_world_base.translation().x() += leg == 0 ? step : 8 - step;
+    T_world_base.translation().y() += 0.25 * ((i / 16) % 4);
+    const Eigen::Isometry3d odometry = T_world_first.inverse() * T_world_base;
+    const double t = 10.0 + i;
+    if (!mapper.AddOdometry(t - 0.15, odometry) || !mapper.AddOdometry(t + 0.05, odometry)) return false;
+    const auto points = test::BoxRoom(kSx, kSy, kSz, 20000, 0.01, static_cast<std::uint32_t>(i + 1),
+                                      (T_world_base * config.T_base_lidar).inverse());
+    if (!mapper.AddScan({points, times, t - 0.1, t})) return false;
+  }
+  return static_cast<bool>(mapper.Finish());
+}
+
+void BM_PlaceCloudBuild(benchmark::State& state) {
+  const int keyframes = static_cast<int>(state.range(0));
+  LocalMapper mapper;
+  if (!MapTheHall(keyframes, mapper)) {
+    state.SkipWithError("mapping the hall failed");
+    return;
+  }
+  PlaceCloudBuilder builder;
+  if (!builder.Init({})) state.SkipWithError("PlaceCloudBuilder::Init");
+  BoundedVector<Eigen::Vector3f> cloud(builder.config().max_points);
+  const Eigen::Vector2d centre_map(4.0, -5.0);  // 3 m from the hall's long wall: the disc holds a stretch of it
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(builder.Build(mapper, centre_map, 5.0f, cloud));
+  }
+  state.counters["keyframes"] = static_cast<double>(mapper.stats().keyframes);
+  state.counters["points"] = static_cast<double>(cloud.size());
+  state.counters["voxel_m"] = static_cast<double>(builder.last_voxel_m());
+}
+BENCHMARK(BM_PlaceCloudBuild)->Arg(50)->Arg(200)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace msgraphs::core

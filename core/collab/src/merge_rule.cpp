@@ -104,7 +104,11 @@ bool OneDirectionRival(const Hypothesis& ch, const Hypothesis& L, MergeInputs& i
       if (ScoreAgreement(*in.walls_a, *in.walls_b, T, sc.agreement).agreement_m < L.agreement.agreement_m) continue;
       Hypothesis h = search.Evaluate(*in.walls_a, *in.walls_b, T);
       if (h.agreement.agreement_m < L.agreement.agreement_m) continue;
-      if (SameTransform(h.T_a_b, L.T_a_b, sc.same_distance_m, sc.same_angle_rad)) continue;
+      // A probe that lands on the leader, or on a transform point evidence set aside (a copy of
+      // a repeated structure along the channel), is no rival.
+      if (SameTransform(h.T_a_b, L.T_a_b, sc.same_distance_m, sc.same_angle_rad) ||
+          SetAside(in, h.T_a_b, sc.same_distance_m, sc.same_angle_rad))
+        continue;
       MeasureConflict(h, in, c.conflict);
       if (h.conflict_m() > c.RefuteLimit(h)) continue;
       h.sources |= kFromChannel;
