@@ -5,8 +5,11 @@
 # S-Graph, all in robot 1's frame).
 #
 #   scripts/run_fleet.sh [--world office] [--robots 3] [--duration-s 180] [--out out/fleet]
-#                        [--inputs udp|lockstep]
+#                        [--inputs udp|lockstep] [--isolated]
 #
+# --isolated: every node on its own DDS domain: the same inputs and the same processes, but no
+#   robot hears another (each collab thread idle). The node reports then give each robot's
+#   timings without the fleet's matching beside them (docs/performance.md).
 # --inputs udp (the demo): each node listens on UDP like a robot's payload computer (Velodyne
 #   packets, CAN odometry as candump lines from a CAN-to-Ethernet gateway) and one
 #   msgraphs_replay per robot sends its recording at the recorded pace; the run lasts as long
@@ -22,6 +25,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 world=office; robots=3; duration=180; out=out/fleet; inputs=lockstep; domain=${MSGRAPHS_DOMAIN:-42}
+isolated=0
 while [[ $# -gt 0 ]]; do
   case $1 in
     --world) world=$2; shift 2 ;;
@@ -29,7 +33,8 @@ while [[ $# -gt 0 ]]; do
     --duration-s) duration=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --inputs) inputs=$2; shift 2 ;;
-    *) echo "usage: $0 [--world W] [--robots N] [--duration-s S] [--out DIR] [--inputs udp|lockstep]" >&2
+    --isolated) isolated=1; shift ;;
+    *) echo "usage: $0 [--world W] [--robots N] [--duration-s S] [--out DIR] [--inputs udp|lockstep] [--isolated]" >&2
        exit 2 ;;
   esac
 done
@@ -64,7 +69,7 @@ for ((r = 1; r <= robots; r++)); do
       printf '[lidar]\nsource = pcap\npcap = %s\n' "$run/robot$r/velodyne.pcap"
       printf '[odometry]\nsource = candump\ncandump = %s\n[replay]\npace = lockstep\n' "$run/robot$r/odometry.log"
     fi
-    printf '[link]\ndomain = %d\nloopback_only = true\n' "$domain"
+    printf '[link]\ndomain = %d\nloopback_only = true\n' $(( isolated ? domain + r : domain ))
     printf '[runtime]\nstatus_period_s = 10\nmax_run_s = %d\n' $(( duration * 3 + 300 ))
     [[ $inputs == lockstep ]] && printf 'exit_after_done_s = 6\n'
     printf '[output]\ndir = %s\n' "$out/nodes/robot$r"

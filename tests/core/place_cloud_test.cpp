@@ -9,6 +9,7 @@
 
 #include "alloc_counter.hpp"
 #include "mapped_room.hpp"
+#include "msgraphs/core/collab/collab_publisher.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/collab/place_cloud.hpp"
 #include "msgraphs/core/collab/place_messages.hpp"
@@ -75,7 +76,7 @@ std::vector<std::uint8_t> Request(std::uint16_t from, std::uint16_t to, std::uin
   return bytes;
 }
 
-TEST(CollabSession, AnswersAPlaceRequestOnceAtTheNextPublishWithinThePeersBudget) {
+TEST(CollabSession, AnswersAPlaceRequestOnceAtTheNextExchangeWithinThePeersBudget) {
   LocalMapper mapper;
   ASSERT_NO_FATAL_FAILURE(MapTheRoom(2.3, mapper));
   CollabSessionConfig config;
@@ -85,10 +86,14 @@ TEST(CollabSession, AnswersAPlaceRequestOnceAtTheNextPublishWithinThePeersBudget
   config.places.budget_bytes_per_peer = PlaceCloudEncodedSize(config.place_cloud.max_points) + 100;
   CollabSession session;
   ASSERT_TRUE(session.Init(config, mapper.config().graph, -mapper.config().base_height_m));
+  CollabPublisher publisher;
+  ASSERT_TRUE(publisher.Init(config, mapper.config().graph, -mapper.config().base_height_m));
+  CollabExchange exchange;
+  ASSERT_TRUE(exchange.Init(config));
   Outbox out;
   ASSERT_TRUE(session.Receive(CollabMessageType::kPlaceRequest, Request(2, 1, 7), out));
-  EXPECT_EQ(out.Count(CollabMessageType::kPlaceCloud), 0u) << "answered at Publish, which has the map";
-  ASSERT_TRUE(session.Publish(mapper, out));
+  EXPECT_EQ(out.Count(CollabMessageType::kPlaceCloud), 0u) << "answered at the next exchange, whose publisher has the map";
+  ASSERT_TRUE(PublishNow(mapper, publisher, exchange, session, out));
   ASSERT_EQ(out.Count(CollabMessageType::kPlaceCloud), 1u);
   const Outbox::Sent* answer = nullptr;
   for (const Outbox::Sent& s : out.sent) {
@@ -108,16 +113,16 @@ TEST(CollabSession, AnswersAPlaceRequestOnceAtTheNextPublishWithinThePeersBudget
   // The same request again (a retry that crossed the answer): not answered twice.
   out.sent.clear();
   ASSERT_TRUE(session.Receive(CollabMessageType::kPlaceRequest, Request(2, 1, 7), out));
-  ASSERT_TRUE(session.Publish(mapper, out));
+  ASSERT_TRUE(PublishNow(mapper, publisher, exchange, session, out));
   EXPECT_EQ(out.Count(CollabMessageType::kPlaceCloud), 0u);
   // A new place: beyond robot 2's budget, refused and counted.
   ASSERT_TRUE(session.Receive(CollabMessageType::kPlaceRequest, Request(2, 1, 8), out));
-  ASSERT_TRUE(session.Publish(mapper, out));
+  ASSERT_TRUE(PublishNow(mapper, publisher, exchange, session, out));
   EXPECT_EQ(out.Count(CollabMessageType::kPlaceCloud), 0u);
   EXPECT_EQ(session.stats().place_requests_refused, 1u);
   // Another robot's request is not ours to answer; a cloud nobody asked for is refused.
   EXPECT_TRUE(session.Receive(CollabMessageType::kPlaceRequest, Request(2, 3, 9), out));
-  ASSERT_TRUE(session.Publish(mapper, out));
+  ASSERT_TRUE(PublishNow(mapper, publisher, exchange, session, out));
   EXPECT_EQ(out.Count(CollabMessageType::kPlaceCloud), 0u);
   std::vector<std::uint8_t> cloud(PlaceCloudEncodedSize(1));
   const std::vector<Eigen::Vector3f> one{{0, 0, 1}};
@@ -140,9 +145,13 @@ TEST(CollabSession, WithTheFallbackOffAPlaceRequestIsRefused) {
   config.places.budget_bytes_per_peer = 0;
   CollabSession session;
   ASSERT_TRUE(session.Init(config, mapper.config().graph, -mapper.config().base_height_m));
+  CollabPublisher publisher;
+  ASSERT_TRUE(publisher.Init(config, mapper.config().graph, -mapper.config().base_height_m));
+  CollabExchange exchange;
+  ASSERT_TRUE(exchange.Init(config));
   Outbox out;
   EXPECT_FALSE(session.Receive(CollabMessageType::kPlaceRequest, Request(2, 1, 7), out));
-  ASSERT_TRUE(session.Publish(mapper, out));
+  ASSERT_TRUE(PublishNow(mapper, publisher, exchange, session, out));
   EXPECT_EQ(out.Count(CollabMessageType::kPlaceCloud), 0u);
   EXPECT_EQ(session.stats().place_requests_refused, 1u);
 }

@@ -34,7 +34,7 @@ void Mission::Exchange(double now_s) {
   }
   for (auto& r : robots) {
     radio.sender = r->index;
-    static_cast<void>(r->session.Publish(r->mapper, radio));
+    static_cast<void>(core::PublishNow(r->mapper, r->publisher, r->exchange, r->session, radio));
   }
   Deliver();
   // Match, deliver the cloud requests and their answers, and align what arrived.

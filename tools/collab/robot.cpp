@@ -61,6 +61,8 @@ std::unique_ptr<Robot> OpenRobot(const std::string& dir_name,
   session_config.robot = r->id();
   Status s = r->mapper.Init(config);
   if (s) s = r->session.Init(session_config, config.graph, -config.base_height_m);
+  if (s) s = r->publisher.Init(session_config, config.graph, -config.base_height_m);
+  if (s) s = r->exchange.Init(session_config);
   if (s) s = r->baseline.collab.Init({}, r->id());
   if (!s) {
     error = s.error().detail;

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "msgraphs/core/collab/collab_publisher.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
 #include "msgraphs/core/descriptors/scan_context.hpp"
@@ -54,6 +55,8 @@ struct Robot {
   const char* delay_source = "none";  ///< "none", "mission.txt" or "--delay-s"
   core::LocalMapper mapper;
   core::CollabSession session;
+  core::CollabPublisher publisher;  ///< the own map for the session (one thread here: PublishNow)
+  core::CollabExchange exchange;
   /// Every merge decision its session logged (drained after each exchange), for --out.
   std::vector<core::MergeLogEntry> merge_log;
   KeyframeBaselineState baseline;

@@ -31,7 +31,7 @@ void KeepSymmetries(const AlignmentSearch& search, double min_constraint_m, Boun
 }  // namespace
 
 void CollabSession::Impl::RefreshOwnMap() {
-  const DistilledGraph& g = distiller.graph();
+  const DistilledGraph& g = own_graph;
   if (own_walls_version == g.version && own_symmetries_version == g.version) return;
   own_walls.Build(g.walls.span(), config.search.min_wall_length_m);
   own_walls_version = g.version;
@@ -76,7 +76,7 @@ void CollabSession::Impl::Log(const Peer& p, MergeEvent event) {
 }
 
 bool CollabSession::Impl::DecidePeer(Peer& p) {
-  const std::uint32_t own_version = distiller.graph().version;
+  const std::uint32_t own_version = own_graph.version;
   if (p.decided_once && p.decided_own == own_version && p.decided_peer == p.graph.version &&
       p.decided_own_free == own_free_version && p.decided_free == p.free_version &&
       p.decided_matches == p.matches.size() && p.decided_places == p.places_version) {
@@ -101,7 +101,7 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
     for (const RoomMatch& m : p.matches) {
       if (!seeds.try_push_back(PlanarTransform::FromIsometry(m.T_a_b))) break;
     }
-    search.Search(own_walls, distiller.graph().rooms.span(), p.walls, p.graph.rooms.span(), seeds.span(), false);
+    search.Search(own_walls, own_graph.rooms.span(), p.walls, p.graph.rooms.span(), seeds.span(), false);
     ++stats.searches;
     if (search.truncated()) ++stats.searches_truncated;
     MergeInputs in;

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The merge decision's fallback in the session (place_evidence.hpp): serving a peer's place
-// requests at Publish, holding the place clouds this robot asked for, weighing them in a
-// decision the rule left undecided between two transforms, and asking for a new place when
-// the held ones cannot tell those two apart.
+// requests (taken for the next exchange, whose publisher builds the clouds, and sent when the
+// exchange is ingested), holding the place clouds this robot asked for, weighing them in a
+// decision the rule left undecided between two transforms, and asking for a new place when the
+// held ones cannot tell those two apart.
 #include <algorithm>
 #include <cmath>
 
@@ -80,33 +81,46 @@ Status CollabSession::Impl::ReceivePlaceCloud(std::span<const std::uint8_t> byte
   return Ok();
 }
 
-void CollabSession::Impl::ServePlaces(const LocalMapper& mapper, CollabOutbox& out) {
-  const std::size_t largest = PlaceCloudEncodedSize(config.place_cloud.max_points);
-  for (const PlaceRequest& q : place_queue) {
-    Peer* p = FindPeer(q.from);
+// Requests are taken for the next exchange where this robot's budget for that peer still holds
+// the largest cloud (reserved until the exchange sends the actual one), and a retry of the place
+// last answered is not served again.
+void CollabSession::TakePlaceRequests(BoundedVector<PlaceRequest>& out) {
+  Impl& m = *impl_;
+  const std::size_t largest = PlaceCloudEncodedSize(m.config.place_cloud.max_points);
+  for (const PlaceRequest& q : m.place_queue) {
+    Impl::Peer* p = m.FindPeer(q.from);
     if (p == nullptr) continue;
     if (p->place_served && p->place_served_id == q.place) continue;  // a retry of one answered
-    if (p->place_bytes_out + largest > config.places.budget_bytes_per_peer) {
-      ++stats.place_requests_refused;  // this peer's budget is spent: the request goes unanswered
+    if (p->place_bytes_out + p->place_bytes_reserved + largest > m.config.places.budget_bytes_per_peer) {
+      ++m.stats.place_requests_refused;  // this peer's budget is spent: the request goes unanswered
       continue;
     }
-    const float radius = std::min(q.radius_m, config.places.radius_m);
-    // Nothing stored there (a place never reached, or its clouds evicted): an empty cloud says so.
-    if (!place_builder.Build(mapper, q.centre_m.cast<double>(), radius, place_scratch)) place_scratch.clear();
+    if (!out.try_push_back(q)) break;  // sized alike: not reached
+    p->place_bytes_reserved += largest;
+    p->place_served = true;
+    p->place_served_id = q.place;
+  }
+  m.place_queue.clear();
+}
+
+void CollabSession::Impl::ServePlaces(const CollabExchange& x, CollabOutbox& out) {
+  const std::size_t largest = PlaceCloudEncodedSize(config.place_cloud.max_points);
+  for (const CollabExchange::Place& place : x.places) {
+    const PlaceRequest& q = place.request;
+    Peer* p = FindPeer(q.from);
+    if (p == nullptr) continue;
+    p->place_bytes_reserved -= std::min<std::uint64_t>(p->place_bytes_reserved, largest);
     const PlaceCloudHeader header{config.robot, q.from, q.place, q.centre_m, static_cast<float>(floor_z_m),
-                                  PlaceCloudStep(radius)};
-    auto n = EncodePlaceCloud(header, place_scratch.span(), buffer);
+                                  PlaceCloudStep(place.radius_m)};
+    auto n = EncodePlaceCloud(header, x.place_points.span().subspan(place.first, place.count), buffer);
     if (!n) {
       ++stats.encode_failures;
       continue;
     }
     p->place_bytes_out += *n;
-    p->place_served = true;
-    p->place_served_id = q.place;
     ++stats.place_requests_served;
     Send(out, CollabMessageType::kPlaceCloud, q.from, *n);
   }
-  place_queue.clear();
 }
 
 void CollabSession::Impl::WeighPlaces(Peer& p, MergeInputs& in, MergeDecision& d) {
@@ -141,7 +155,7 @@ void CollabSession::Impl::AskForPlace(Peer& p, CollabOutbox& out) {
     return true;
   };
   if (p.place_pending) {
-    // The peer answers at its next Publish; unanswered, asked again (request_retry_calls).
+    // The peer answers at its next exchange; unanswered, asked again (request_retry_calls).
     if (calls - p.place_requested_call < config.request_retry_calls) return;
     if (p.place_tries >= kPlaceRetries) {
       p.place_pending = false;  // given up: the next undecided decision asks elsewhere

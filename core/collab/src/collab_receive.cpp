@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // CollabSession::Receive: a peer's message decoded into the session's stores (every decoder
 // checks it; a malformed one is counted and dropped), a room cloud request answered at once, a
-// place request queued for the next Publish.
+// place request queued for the next exchange.
 #include <algorithm>
 
 #include "collab_session_impl.hpp"

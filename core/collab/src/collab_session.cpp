@@ -9,20 +9,11 @@
 #include <cmath>
 
 #include "collab_session_impl.hpp"
+#include "msgraphs/core/collab/collab_publisher.hpp"
 #include "msgraphs/core/collab/distilled_codec.hpp"
 #include "msgraphs/core/collab/free_space_codec.hpp"
 
 namespace msgraphs::core {
-namespace {
-
-bool SignificantlyChanged(const DistilledRoom& a, const DistilledRoom& b, double threshold_m) {
-  return a.walls != b.walls || a.shape != b.shape || (a.centre - b.centre).norm() > threshold_m ||
-         std::fabs(a.size_x_m - b.size_x_m) > threshold_m ||
-         std::fabs(a.size_y_m - b.size_y_m) > threshold_m;
-}
-
-}  // namespace
-
 const char* CollabMessageTypeName(CollabMessageType type) {
   switch (type) {
     case CollabMessageType::kDistilledGraph:
@@ -63,9 +54,10 @@ Status CollabSessionConfig::Validate() const {
   if (robot == 0) return Error{Errc::kInvalidConfig, "collab session: robot id must be 1..65535"};
   if (max_peers < 1 || max_rooms < 1 || max_room_points < 100 || max_peer_rooms < 1 ||
       max_pending < 1 || max_matches_per_peer < 2 || max_matches_per_peer > 64 || cloud_cache < 1 ||
-      max_message_bytes < 4096) {
+      max_message_bytes < 4096 || rooms_per_exchange < 1 || room_points_per_exchange < max_room_points) {
     return Error{Errc::kInvalidConfig,
-                 "collab session: capacities must be positive (2..64 matches per peer)"};
+                 "collab session: capacities must be positive (2..64 matches per peer; an exchange holds "
+                 "the largest room cloud)"};
   }
   if (cloud_encoding != CloudEncoding::kFloat32 &&
       !(cloud_step_m > 0 && cloud_step_m < 1 && max_cloud_step_m >= cloud_step_m))
@@ -147,11 +139,9 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
   Impl& m = *impl_;
   m.config = config;
   m.floor_z_m = floor_z_map_m;
-  if (auto s = m.distiller.Init(config.robot, graph_config, config.distiller); !s) return s;
-  // The builder thins a room's cloud to what the store holds: a hall is described, never refused.
-  RoomDescriptorConfig descriptor = config.descriptor;
-  descriptor.max_cloud_points = config.max_room_points;
-  if (auto s = m.builder.Init(descriptor); !s) return s;
+  if (graph_config.max_planes < 1) return Error{Errc::kInvalidConfig, "collab session: no planes"};
+  m.own_graph.Init(config.distiller.max_walls, config.distiller.max_rooms);
+  m.own_graph.robot = config.robot;
   if (auto s = m.matcher.Init(config.matcher); !s) return s;
   if (auto s = m.graph.Init(config.graph, config.robot); !s) return s;
   m.stats = CollabSessionStats{};
@@ -180,7 +170,6 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
   }
   bytes += config.max_peers * config.places.max_places_per_peer *
            (sizeof(SessionHeldPlace) + config.place_cloud.max_points * 12);
-  if (auto s = m.place_builder.Init(config.place_cloud); !s) return s;
   m.place_scorer.Init(config.place_cloud.max_points);
   m.place_chooser.Init(config.free_space.max_cells);
   m.place_queue.Init(config.places.max_requests_queued);
@@ -237,12 +226,20 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
   return Ok();
 }
 
-Status CollabSession::Publish(const LocalMapper& mapper, CollabOutbox& out) {
+Status CollabSession::Ingest(CollabExchange& x, const CollabPublisherStats& from, CollabOutbox& out) {
   Impl& m = *impl_;
-  m.distiller.Update(mapper.graph(), mapper.plane_mapper());
-  m.stats.marginal_updates = m.distiller.stats().marginal_updates;
-  m.stats.marginal_failures = m.distiller.stats().marginal_failures;
-  const DistilledGraph& g = m.distiller.graph();
+  m.stats.marginal_updates = from.marginal_updates;
+  m.stats.marginal_failures = from.marginal_failures;
+  m.stats.free_space_build_failures = from.free_space_build_failures;
+  m.stats.rooms_refused = from.rooms_refused;
+  m.stats.room_clouds_too_large = from.room_clouds_too_large;
+  m.stats.rooms_deferred = from.rooms_deferred;
+  m.stats.room_points_peak = from.room_points_peak;
+  if (x.graph.version < m.own_graph.version)
+    return Error{Errc::kInvalidArgument, "collab session: an exchange older than the last one"};
+  DistilledGraph& g = m.own_graph;
+  g.CopyFrom(x.graph);  // capacities sized alike
+  g.robot = m.config.robot;
   if (g.version > m.sent_version) {
     auto n = EncodeDistilled(g, m.sent_version, m.buffer);
     if (!n) {
@@ -252,50 +249,40 @@ Status CollabSession::Publish(const LocalMapper& mapper, CollabOutbox& out) {
     m.Send(out, CollabMessageType::kDistilledGraph, 0, *n);
     m.sent_version = g.version;
   }
-  m.PublishFreeSpace(mapper, out);
-  m.ServePlaces(mapper, out);
-  for (const DistilledRoom& room : g.rooms) {
-    Impl::OwnRoom* slot = m.FindOwn(room.id);
-    if (slot != nullptr) {
-      slot->room = room;  // the latest estimate, for the frames
-      if (!SignificantlyChanged(slot->at_build, room, m.config.descriptor_resend_m)) {
-        if (slot->sent) continue;
-      } else {
-        slot->sent = false;
-        slot->version = 0;  // rebuild below
-      }
-    } else {
+  if (x.free_built) {
+    // Swapped, not copied: the exchange takes the old summary, which its next Prepare rebuilds.
+    std::swap(m.own_free, x.free);
+    x.free_built = false;
+    m.IngestFreeSpace(out);
+  }
+  m.ServePlaces(x, out);
+  for (const CollabExchange::Room& built : x.rooms) {
+    Impl::OwnRoom* slot = m.FindOwn(built.id);
+    if (slot == nullptr) {
       for (Impl::OwnRoom& r : m.own) {
         if (r.used) continue;
         slot = &r;
         break;
       }
-      if (slot == nullptr) {
-        ++m.stats.rooms_refused;
-        continue;
-      }
+      if (slot == nullptr) continue;  // as many slots as the publisher's: not reached
+      ++m.stats.own_rooms;
+      m.stats.own_rooms_peak = std::max(m.stats.own_rooms_peak, m.stats.own_rooms);
     }
-    if (slot->version == 0 || !slot->used) {
-      // New or changed: rebuild its cloud and descriptor.
-      if (!m.builder.Build(mapper, room, m.cloud_scratch, m.descriptor_scratch)) continue;
-      m.stats.room_points_peak = std::max(m.stats.room_points_peak, m.cloud_scratch.size());
-      if (m.cloud_scratch.size() > slot->cloud.capacity()) {
-        ++m.stats.room_clouds_too_large;
-        continue;
-      }
-      if (!slot->used) {
-        ++m.stats.own_rooms;
-        m.stats.own_rooms_peak = std::max(m.stats.own_rooms_peak, m.stats.own_rooms);
-      }
-      slot->used = true;
-      slot->id = room.id;
-      slot->version = std::max<std::uint32_t>(room.version, 1);
-      slot->room = room;
-      slot->at_build = room;
-      slot->descriptor = m.descriptor_scratch;
-      slot->cloud.clear();
-      for (const Eigen::Vector3f& p : m.cloud_scratch) slot->cloud.push_back(p);
-    }
+    slot->used = true;
+    slot->sent = false;
+    slot->id = built.id;
+    slot->version = built.version;
+    slot->room = built.at_build;
+    slot->at_build = built.at_build;
+    slot->descriptor = built.descriptor;
+    slot->cloud.clear();
+    for (std::size_t i = 0; i < built.count; ++i) slot->cloud.push_back(x.room_points[built.first + i]);
+  }
+  for (const DistilledRoom& room : g.rooms) {
+    Impl::OwnRoom* slot = m.FindOwn(room.id);
+    if (slot == nullptr) continue;  // no descriptor yet
+    slot->room = room;  // the latest estimate, for the frames
+    if (slot->sent) continue;
     auto n =
         EncodeRoomDescriptor({m.config.robot, slot->id, slot->version}, slot->descriptor, m.buffer);
     if (!n) {
@@ -308,13 +295,8 @@ Status CollabSession::Publish(const LocalMapper& mapper, CollabOutbox& out) {
   return Ok();
 }
 
-
-// The summary is rebuilt at every publish and sent when enough of it changed.
-void CollabSession::Impl::PublishFreeSpace(const LocalMapper& mapper, CollabOutbox& out) {
-  if (!own_free.Build(mapper.grid(), distiller.graph().walls.span())) {
-    ++stats.free_space_build_failures;
-    return;
-  }
+// The summary is rebuilt at every exchange and sent when enough of it changed.
+void CollabSession::Impl::IngestFreeSpace(CollabOutbox& out) {
   bool changed = own_free.width() != sent_free_width || own_free.height() != sent_free_height ||
                  own_free.origin_m() != sent_free_origin || own_free.openings().size() != sent_free_openings;
   if (!changed) {
@@ -373,12 +355,12 @@ bool CollabSession::Match(CollabOutbox& out, double now_s) {
     m.stats.rejected_consistency += p.matches.size() - p.consistent_count;
     m.stats.undecided += p.stats.undecided ? 1u : 0u;
   }
-  moved = moved || (m.stats.solves > 0 && m.distiller.graph().version != m.solved_version);
+  moved = moved || (m.stats.solves > 0 && m.own_graph.version != m.solved_version);
   if (changed || moved || merges_changed) m.Solve();
   return changed;
 }
 
-const DistilledGraph& CollabSession::distilled() const { return impl_->distiller.graph(); }
+const DistilledGraph& CollabSession::distilled() const { return impl_->own_graph; }
 
 bool CollabSession::merged(std::uint16_t robot) const {
   if (robot == impl_->config.robot) return true;

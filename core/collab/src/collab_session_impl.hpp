@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "msgraphs/core/collab/collab_publisher.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/collab/place_decision.hpp"
 #include "msgraphs/core/collab/place_messages.hpp"
@@ -45,8 +46,7 @@ struct SessionHeldPlace {
 struct CollabSession::Impl {
   CollabSessionConfig config;
   double floor_z_m = 0;
-  Distiller distiller;
-  RoomDescriptorBuilder builder;
+  DistilledGraph own_graph;  // this robot's, as the last exchange brought it
   RoomMatcher matcher;
   CollaborativeGraph graph;
   CollabSessionStats stats;
@@ -125,6 +125,7 @@ struct CollabSession::Impl {
     std::uint32_t place_pending_id = 0, place_tries = 0, next_place = 0;
     std::uint64_t place_requested_call = 0;
     std::uint64_t place_bytes_in = 0, place_bytes_out = 0;
+    std::uint64_t place_bytes_reserved = 0;  // requests taken for the next exchange, at the largest
     bool place_served = false;  // the last place this peer asked for was answered
     std::uint32_t place_served_id = 0;
     PlanarTransform duel_first, duel_second;
@@ -160,7 +161,6 @@ struct CollabSession::Impl {
   bool solve_needed = false;
   // The fallback: requests from peers awaiting the next Publish, the builder, the scorer.
   BoundedVector<PlaceRequest> place_queue;
-  PlaceCloudBuilder place_builder;
   PlaceScorer place_scorer;
   PlaceChooser place_chooser;
   BoundedVector<Eigen::Vector3f> place_scratch;
@@ -207,7 +207,7 @@ struct CollabSession::Impl {
   }
 
   // collab_session.cpp
-  void PublishFreeSpace(const LocalMapper& mapper, CollabOutbox& out);
+  void IngestFreeSpace(CollabOutbox& out);
   // collab_room_matching.cpp
   void SendRequest(CollabOutbox& out, const Peer& p, const Pending& q);
   bool AddMatch(Peer& p, const RoomMatch& m);
@@ -223,7 +223,7 @@ struct CollabSession::Impl {
   // collab_places.cpp
   Status ReceivePlaceRequest(std::span<const std::uint8_t> bytes);
   Status ReceivePlaceCloud(std::span<const std::uint8_t> bytes);
-  void ServePlaces(const LocalMapper& mapper, CollabOutbox& out);
+  void ServePlaces(const CollabExchange& x, CollabOutbox& out);
   void WeighPlaces(Peer& p, MergeInputs& in, MergeDecision& d);
   void AskForPlace(Peer& p, CollabOutbox& out);
 };

@@ -18,7 +18,7 @@ void CollabSession::Impl::Solve() {
   wall_pairs.clear();
   stats.graph_refused = 0;
   stats.solve_room_pairs = stats.solve_wall_pairs = stats.solve_origin_measurements = 0;
-  const DistilledGraph& mine = distiller.graph();
+  const DistilledGraph& mine = own_graph;
   const double cos_pair = std::cos(config.wall_pair_angle_rad);
   // A pair of coinciding walls: tied wall to wall in the walls modes, and in every mode kept for
   // the priors that feed the peer's measurement back into the local S-Graph (PlanePriors), so
@@ -124,7 +124,7 @@ void CollabSession::Impl::Solve() {
   if (any_merged) attach(config.robot, mine, floor_z_m);
   ++stats.solves;
   if (!graph.Solve()) ++stats.solve_failures;
-  solved_version = distiller.graph().version;
+  solved_version = own_graph.version;
   for (Peer& p : peers) {
     if (!p.used) continue;
     p.solved_version = p.graph.version;
@@ -134,7 +134,7 @@ void CollabSession::Impl::Solve() {
 
 std::size_t CollabSession::PlanePriors(std::span<PlanePrior> out) const {
   Impl& m = *impl_;
-  const DistilledGraph& mine = m.distiller.graph();
+  const DistilledGraph& mine = m.own_graph;
   std::size_t n = 0;
   m.stats.priors_gated = 0;
   for (const SessionWallPair& q : m.wall_pairs) {

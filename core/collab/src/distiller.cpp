@@ -27,10 +27,20 @@ Status Distiller::Init(std::uint16_t robot,
   eligible_.Init(graph.max_planes);
   marginals_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
   stats_ = {};
+  updated_once_ = false;
   return Ok();
 }
 
 bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
+  // The S-Graph as it was at the last Update: the distilled graph would come out the same, and the
+  // marginals (one factorisation of the whole problem) are not recomputed.
+  const std::uint64_t revision = graph.stats().revision;
+  if (updated_once_ && revision == revision_) {
+    ++stats_.unchanged;
+    return false;
+  }
+  updated_once_ = true;
+  revision_ = revision;
   const std::uint32_t next = out_.version + 1;
   bool changed = false;
   // Walls the rooms stand on are always shared.

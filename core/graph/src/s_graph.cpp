@@ -86,6 +86,7 @@ Status SGraph::Init(const SGraphConfig& config) {
 Expected<std::uint32_t> SGraph::AddKeyframe(double stamp_s,
                                             const Eigen::Isometry3d& T_map_keyframe) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
   if (!std::isfinite(stamp_s) || !IsValidRigidTransform(T_map_keyframe, 1e-6)) {
     ++m.stats.rejected_pose;
@@ -146,6 +147,7 @@ Expected<std::uint32_t> SGraph::AddRelativePose(std::uint32_t from,
                                                 const Eigen::Isometry3d& T_from_to,
                                                 const Matrix6d& information,
                                                 RelativePoseKind kind) {
+  ++impl_->stats.revision;  // every call that may change the graph
   return impl_->AddRelative(from, to, T_from_to, information, kind);
 }
 
@@ -162,6 +164,7 @@ Expected<double> SGraph::FactorChi2(std::uint32_t factor) const {
 
 Status SGraph::RemoveFactor(std::uint32_t factor) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (factor >= m.factor_high_water || !m.factors[factor].active)
     return Error{Errc::kNotFound, "no such factor"};
   const FactorKind kind = m.factors[factor].kind;
@@ -177,6 +180,7 @@ Expected<std::uint32_t> SGraph::AddPlane(const Eigen::Vector3d& normal_map,
                                          double d_map,
                                          PlaneClass plane_class) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!normal_map.allFinite() || !std::isfinite(d_map) || normal_map.norm() < 1e-6) {
     ++m.stats.rejected_pose;
     return Error{Errc::kInvalidArgument, "plane is not finite"};
@@ -202,6 +206,7 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
                                    const PlaneMeasurement& z,
                                    double behind_margin_m) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!m.ValidKeyframe(keyframe) || !m.ValidPlane(plane)) {
     ++m.stats.rejected_missing_node;
     return Error{Errc::kNotFound, "plane observation of a missing keyframe or plane"};
@@ -268,6 +273,7 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
 
 Expected<std::uint32_t> SGraph::AddRoom(const MapRoom& room) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (m.room_count >= m.rooms.size()) {
     ++m.stats.rejected_capacity;
     return Error{Errc::kCapacityExceeded, "s-graph room store full"};
@@ -290,6 +296,7 @@ Expected<std::uint32_t> SGraph::AddRoom(const MapRoom& room) {
 
 Status SGraph::UpdateRoom(std::uint32_t id, const MapRoom& updated) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!m.ValidRoom(id)) {
     ++m.stats.rejected_missing_node;
     return Error{Errc::kNotFound, "no such room"};
@@ -352,6 +359,7 @@ Status SGraph::UpdateRoom(std::uint32_t id, const MapRoom& updated) {
 
 Status SGraph::RemoveRoom(std::uint32_t id) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!m.ValidRoom(id)) return Error{Errc::kNotFound, "no such room"};
   RoomNode& r = m.rooms[id];
   if (r.factor != kNone) m.RemoveFactor(r.factor);
@@ -365,6 +373,7 @@ Status SGraph::RemoveRoom(std::uint32_t id) {
 
 Status SGraph::AddWallWall(std::uint32_t a, std::uint32_t b) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (a == b || !m.ValidPlane(a) || !m.ValidPlane(b) || !m.planes[a].in_problem ||
       !m.planes[b].in_problem) {
     ++m.stats.rejected_missing_node;
@@ -388,6 +397,7 @@ Status SGraph::AddWallWall(std::uint32_t a, std::uint32_t b) {
 
 Expected<std::uint32_t> SGraph::AddPlanePrior(const PlanePrior& prior) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!m.ValidPlane(prior.plane) || !m.planes[prior.plane].in_problem) {
     ++m.stats.rejected_missing_node;
     return Error{Errc::kNotFound, "plane prior on a missing plane"};
@@ -429,6 +439,7 @@ Expected<std::uint32_t> SGraph::AddPlanePrior(const PlanePrior& prior) {
 
 Status SGraph::SetFloor(const Eigen::Vector2d& centre) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!centre.allFinite()) {
     ++m.stats.rejected_pose;
     return Error{Errc::kInvalidArgument, "floor centre not finite"};
@@ -444,6 +455,7 @@ Status SGraph::SetFloor(const Eigen::Vector2d& centre) {
 
 Status SGraph::AddFloorRoom(std::uint32_t room) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   if (!m.floor_active || !m.ValidRoom(room)) {
     ++m.stats.rejected_missing_node;
     return Error{Errc::kNotFound, "floor-room factor without floor or room"};
@@ -465,6 +477,7 @@ Status SGraph::AddFloorRoom(std::uint32_t room) {
 
 Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
   Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
   SGraphSolveReport report;
   report.kind = kind;
   if (m.active_factors == 0) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The collab thread: messages from the link into the session, room matching, and the two
-// recovery paths of the link:
+// The collab thread: messages from the link into the session, the own map the SLAM thread
+// prepared (the exchange) out through the session, room matching, and the two recovery paths
+// of the link:
 // - a robot we hear whose graph we lack or hold behind for a while (we joined late, a delta
 //   was lost, the link was cut) is put on our resync list, which our telemetry carries;
 // - a robot whose telemetry lists us gets everything again (ResendAll, published by the SLAM
@@ -24,6 +25,47 @@ constexpr Duration kBehindPatience = Duration::FromSeconds(3.0);
 constexpr Duration kResendInterval = Duration::FromSeconds(2.0);
 
 }  // namespace
+
+void Node::Impl::PublishCollabStatus() {
+  SlamStatus::PeerLine lines[SlamStatus::kPeerLines];
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < session.peers() && n < SlamStatus::kPeerLines; ++i) {
+    const core::CollabPeerStats p = session.peer_stats(i);
+    std::uint64_t in = 0;
+    for (std::uint64_t b : p.bytes_received) in += b;
+    lines[n++] = {p.robot, p.merged, in};
+  }
+  std::lock_guard<std::mutex> lock(status_mutex);
+  std::copy_n(lines, n, slam_status.peer_lines.begin());
+  slam_status.peer_count = n;
+  slam_status.malformed = session.stats().malformed;
+}
+
+void Node::Impl::IngestExchange() {
+  ExchangeSlot* taken = exchanges.Take();
+  if (taken == nullptr) return;
+  ExchangeSlot& slot = *taken;
+  std::uint32_t version = 0;
+  {
+    std::lock_guard<std::mutex> lock(session_mutex);
+    static_cast<void>(session.Ingest(slot.x, slot.publisher, *link));
+    version = session.distilled().version;
+    RefreshRosFleet();
+    PublishCollabStatus();
+  }
+  const SteadyTime now = platform::SteadyNow();
+  {
+    std::lock_guard<std::mutex> lock(status_mutex);
+    for (const SteadyTime t : slot.keyframes) wire_ms.Add((now - t).seconds() * 1e3);
+    slam_status.graph_version = version;
+    slam_status.publishes += 1;
+    slam_status.wire_p50_ms = wire_ms.Percentile(0.5);
+    slam_status.wire_p99_ms = wire_ms.Percentile(0.99);
+    slam_status.wire_max_ms = wire_ms.Percentile(1.0);
+    slam_status.wire_samples = wire_ms.count();
+  }
+  exchanges.Release();
+}
 
 void Node::Impl::CollabLoop() {
   static_cast<void>(platform::SetCurrentThreadName("msg-collab"));
@@ -58,6 +100,21 @@ void Node::Impl::CollabLoop() {
         }
         ++received;
       } while (received < kMessagesPerRound && link->Receive(message, Duration()));
+      PublishCollabStatus();
+    }
+    // The own map the SLAM thread prepared, and peers' place requests for its next one.
+    IngestExchange();
+    {
+      std::lock_guard<std::mutex> lock(session_mutex);
+      requests_taken.clear();
+      session.TakePlaceRequests(requests_taken);
+    }
+    if (!requests_taken.empty()) {
+      std::lock_guard<std::mutex> lock(requests_mutex);
+      for (const core::PlaceRequest& q : requests_taken) {
+        // Full only when the SLAM thread has not prepared for a while: the peer asks again.
+        if (!requests_mailbox.try_push_back(q)) requests_dropped.fetch_add(1, std::memory_order_relaxed);
+      }
     }
     pending_change = pending_change || changed;
     bool origins_changed = false;
@@ -77,8 +134,18 @@ void Node::Impl::CollabLoop() {
         }
         merge_log_sequence = merge_log_scratch[n - 1].sequence;
       }
+      const double match_took_ms = (platform::SteadyNow() - before_match).seconds() * 1e3;
+      match_ms.Add(match_took_ms);
+      {
+        std::lock_guard<std::mutex> status_lock(status_mutex);
+        slam_status.match_p50_ms = match_ms.Percentile(0.5);
+        slam_status.match_p99_ms = match_ms.Percentile(0.99);
+        slam_status.match_max_ms = match_ms.Percentile(1.0);
+      }
       changed = pending_change;
       pending_change = false;
+      if (changed || origins_changed) RefreshRosFleet();
+      PublishCollabStatus();
       if ((changed || origins_changed) && config.feedback) {
         // The priors are recomputed whenever a peer's walls or an origin moved; the SLAM
         // thread takes the newest at its next exchange.

@@ -116,6 +116,15 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
   if (Status s = m.session.Init(config.collab, config.mapper.graph, -config.mapper.base_height_m);
       !s)
     return fail("collab session", s.error());
+  if (Status s = m.publisher.Init(config.collab, config.mapper.graph, -config.mapper.base_height_m);
+      !s)
+    return fail("collab publisher", s.error());
+  for (Impl::ExchangeSlot& slot : m.exchanges.slots()) {
+    if (Status s = slot.x.Init(config.collab); !s) return fail("collab exchange", s.error());
+    slot.keyframes.reserve(4096);
+  }
+  m.requests_mailbox.Init(config.collab.places.max_requests_queued);
+  m.requests_taken.Init(config.collab.places.max_requests_queued);
   m.priors_mailbox.resize(config.mapper.max_plane_priors);
   m.priors_scratch.resize(config.mapper.max_plane_priors);
   m.priors_scratch_collab.resize(config.mapper.max_plane_priors);
@@ -204,18 +213,13 @@ link::Telemetry Node::Impl::MakeTelemetry() const {
     t.walls = slam_status.walls;
     t.rooms = slam_status.rooms;
     t.graph_version = slam_status.graph_version;
+    for (std::size_t i = 0; i < slam_status.peer_count && !t.merged.full(); ++i)
+      if (slam_status.peer_lines[i].merged) t.merged.push_back(slam_status.peer_lines[i].robot);
   }
   const link::LinkStats stats = link->stats();
   for (const link::TopicStats& s : stats.topics) {
     t.bytes_sent += s.sent_bytes;
     t.bytes_received += s.received_bytes;
-  }
-  {
-    std::lock_guard<std::mutex> lock(session_mutex);
-    for (std::size_t i = 0; i < session.peers() && !t.merged.full(); ++i) {
-      const core::CollabPeerStats s = session.peer_stats(i);
-      if (s.merged) t.merged.push_back(s.robot);
-    }
   }
   {
     std::lock_guard<std::mutex> lock(resync_mutex);
@@ -245,19 +249,13 @@ void Node::Impl::PrintStatus(double since_start_s) {
     rejected += t.rejected_version + t.rejected_sender + t.rejected_oversize + t.undecodable;
   }
   std::string peers;
-  std::uint64_t malformed = 0;
-  {
-    std::lock_guard<std::mutex> lock(session_mutex);
-    malformed = session.stats().malformed;
-    for (std::size_t i = 0; i < session.peers(); ++i) {
-      const core::CollabPeerStats p = session.peer_stats(i);
-      std::uint64_t in = 0;
-      for (std::uint64_t b : p.bytes_received) in += b;
-      char buffer[96];
-      std::snprintf(buffer, sizeof buffer, "%s r%u %s %.1f kB in", peers.empty() ? "" : ",",
-                    p.robot, p.merged ? "merged" : "not merged", static_cast<double>(in) / 1e3);
-      peers += buffer;
-    }
+  const std::uint64_t malformed = s.malformed;
+  for (std::size_t i = 0; i < s.peer_count; ++i) {
+    const SlamStatus::PeerLine& p = s.peer_lines[i];
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, "%s r%u %s %.1f kB in", peers.empty() ? "" : ",", p.robot,
+                  p.merged ? "merged" : "not merged", static_cast<double>(p.bytes_in) / 1e3);
+    peers += buffer;
   }
   // Points cut from sweeps are shown only when there are any (a sensor beyond the assembler's
   // capacity), so the usual line stays as parsers know it.

@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "msgraphs/core/collab/collab_publisher.hpp"
 #include "msgraphs/core/collab/collab_session.hpp"
 #include "msgraphs/core/slam/local_mapper.hpp"
 #include "msgraphs/drivers/gpio/gpio.hpp"
@@ -22,6 +23,7 @@
 #include "msgraphs/runtime/link/fleet_link.hpp"
 #include "msgraphs/runtime/link/ros_publisher.hpp"
 #include "msgraphs/runtime/pipeline/bounded_queue.hpp"
+#include "msgraphs/runtime/pipeline/handover.hpp"
 #include "msgraphs/runtime/pipeline/journal.hpp"
 #include "msgraphs/runtime/pipeline/latency_window.hpp"
 #include "msgraphs/runtime/pipeline/node.hpp"
@@ -63,13 +65,31 @@ struct InputCounters {
   }
 };
 
-/// What the SLAM thread reports after each scan (under `mutex`).
+/// What the SLAM thread reports after each scan and the collab thread after each exchange and
+/// Match (under `status_mutex`).
 struct SlamStatus {
   std::uint64_t scans = 0, keyframes = 0, no_odometry = 0;
   std::uint32_t walls = 0, rooms = 0;
   std::uint32_t graph_version = 0;  ///< the distilled version we have sent
   double keyframe_p50_ms = 0, keyframe_p99_ms = 0;
   double wire_p50_ms = 0, wire_p99_ms = 0, wire_max_ms = 0;  ///< last packet -> on the wire
+  /// The SLAM thread's time in an exchange (priors, Prepare, the hand-over, the ROS view).
+  double exchange_p50_ms = 0, exchange_p99_ms = 0, exchange_max_ms = 0;
+  /// Exchanges not prepared because the last one was not taken yet (tried again after each scan,
+  /// each try counted).
+  std::uint64_t exchanges_deferred = 0;
+  double match_p50_ms = 0, match_p99_ms = 0, match_max_ms = 0;  ///< the collab thread's Match
+  // Written by the collab thread from the session (PublishCollabStatus), so that telemetry and
+  // status lines never wait for a Match either.
+  struct PeerLine {
+    std::uint16_t robot = 0;
+    bool merged = false;
+    std::uint64_t bytes_in = 0;
+  };
+  static constexpr std::size_t kPeerLines = 32;  ///< Telemetry::merged holds as many
+  std::array<PeerLine, kPeerLines> peer_lines{};
+  std::size_t peer_count = 0;
+  std::uint64_t malformed = 0;
   std::uint64_t wire_samples = 0;
   std::uint64_t publishes = 0;
   std::size_t plane_priors = 0;
@@ -97,11 +117,37 @@ struct Node::Impl {
   mutable std::mutex status_mutex;
   SlamStatus slam_status;
 
-  // The collaborative side: session under session_mutex (SLAM and collab threads).
+  // The collaborative side: the session under session_mutex (the collab thread; the supervisor
+  // reads it for telemetry and at exit). The SLAM thread never takes it.
   mutable std::mutex session_mutex;
   core::CollabSession session;
+  // The own map for the session: prepared by the SLAM thread (publisher), ingested by the collab
+  // thread (handover.hpp: while the last one still waits, the SLAM thread prepares nothing and
+  // tries again after its next scan: exchanges_deferred).
+  core::CollabPublisher publisher;  ///< SLAM thread only
+  struct ExchangeSlot {
+    core::CollabExchange x;
+    std::vector<SteadyTime> keyframes;  ///< last-packet times of the keyframes it first carries
+    core::CollabPublisherStats publisher;  ///< the publisher's, when it was prepared
+  };
+  Handover<ExchangeSlot> exchanges;
+  /// Collab thread: the posted exchange, if any, into the session and out through the link.
+  void IngestExchange();
+  // Peers' place requests the session let through, for the next exchange (collab -> SLAM).
+  std::mutex requests_mutex;
+  BoundedVector<core::PlaceRequest> requests_mailbox, requests_taken;
+  std::atomic<std::uint64_t> requests_dropped{0};  ///< the mailbox full (the peer asks again)
+  // Every robot's walls and rooms in this robot's frame, for the ROS view (collab -> SLAM).
+  std::mutex ros_fleet_mutex;
+  link::RosMapView ros_fleet, ros_fleet_scratch;
+  /// Collab thread, under session_mutex: ros_fleet from the session.
+  void RefreshRosFleet();
+  /// Collab thread, under session_mutex: the peers' lines of SlamStatus.
+  void PublishCollabStatus();
+  LatencyWindow exchange_ms{4096};  ///< SLAM thread
+  LatencyWindow match_ms{4096};     ///< collab thread
   std::unique_ptr<link::FleetLink> link;
-  std::unique_ptr<link::RosPublisher> ros;  ///< SLAM thread only (Exchange)
+  std::unique_ptr<link::RosPublisher> ros;  ///< SLAM thread only (Exchange); set before the threads
   link::RosMapView ros_view;
   SteadyTime ros_cloud_last;
   bool ros_cloud_sent = false;
@@ -173,8 +219,9 @@ struct Node::Impl {
   void OdometryLoop();
   void SlamLoop();
   void CollabLoop();
-  // SLAM thread: Publish under the session lock, apply the newest priors.
-  void Exchange();
+  /// SLAM thread: priors in, the own map prepared and posted for the collab thread; false when
+  /// the last exchange was not taken yet (nothing prepared: try again after the next scan).
+  bool Exchange();
   // Supervisor (node.cpp) and the end-of-run outputs (node_report.cpp).
   link::Telemetry MakeTelemetry() const;
   void PrintStatus(double since_start_s);

@@ -187,6 +187,12 @@ void Node::Impl::PrintReport() {
           "%.0f ms p99, %.0f ms max (%" PRIu64 " keyframes)\n",
           s.keyframe_p50_ms, s.keyframe_p99_ms, s.wire_p50_ms, s.wire_p99_ms, s.wire_max_ms,
           s.wire_samples);
+  Appendf(text,
+          "  threads: SLAM thread's exchanges %.1f ms p50, %.1f ms p99, %.1f ms max (%" PRIu64
+          " tries deferred: the last one not taken yet); collab thread's Match %.1f ms p50, %.1f ms "
+          "p99, %.1f ms max\n",
+          s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
+          s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
   if (journal) {
     std::lock_guard<std::mutex> lock(journal_mutex);
     Appendf(text,
@@ -238,6 +244,11 @@ void Node::Impl::PrintReport() {
           "scan_queue_peak %zu\nscans_dropped %" PRIu64 "\npeak_rss_mb %.1f\n",
           s.keyframe_p50_ms, s.keyframe_p99_ms, s.wire_p50_ms, s.wire_p99_ms, sq.peak, sq.dropped,
           static_cast<double>(usage.ru_maxrss) / 1024.0);
+  Appendf(stats,
+          "exchange_p50_ms %.2f\nexchange_p99_ms %.2f\nexchange_max_ms %.2f\nexchanges_deferred %" PRIu64
+          "\nmatch_p50_ms %.2f\nmatch_p99_ms %.2f\nmatch_max_ms %.2f\n",
+          s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
+          s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
   if (!config.output_dir.empty()) {

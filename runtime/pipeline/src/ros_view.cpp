@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The SLAM thread's view of the collaborative map for the ROS 2 topics: this robot's keyframes
-// and every merged robot's walls and rooms, brought into this robot's map frame.
+// and every merged robot's walls and rooms, brought into this robot's map frame. The walls and
+// rooms come from the session, which the collab thread owns: it refreshes a copy after each
+// exchange and each Match that changed something, and the SLAM thread reads the copy.
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +36,27 @@ void AddGraph(const core::DistilledGraph& g, const Eigen::Isometry3d& T, link::R
 
 }  // namespace
 
+void Node::Impl::RefreshRosFleet() {
+  if (!ros) return;
+  link::RosMapView& f = ros_fleet_scratch;
+  f.walls.clear();
+  f.rooms.clear();
+  f.origins.clear();
+  AddGraph(session.distilled(), Eigen::Isometry3d::Identity(), f);
+  for (std::size_t i = 0; i < session.peers(); ++i) {
+    const core::CollabPeerStats s = session.peer_stats(i);
+    const core::DistilledGraph* g = session.peer_graph(s.robot);
+    if (!s.merged || g == nullptr) continue;
+    const Eigen::Isometry3d T = session.T_self_robot(s.robot);
+    AddGraph(*g, T, f);
+    f.origins.push_back({FrameOf(s.robot), T});
+  }
+  std::lock_guard<std::mutex> lock(ros_fleet_mutex);
+  std::swap(ros_fleet.walls, f.walls);
+  std::swap(ros_fleet.rooms, f.rooms);
+  std::swap(ros_fleet.origins, f.origins);
+}
+
 void Node::Impl::PublishRos() {
   if (!ros) return;
   link::RosMapView& v = ros_view;
@@ -58,16 +81,11 @@ void Node::Impl::PublishRos() {
   for (const link::FleetLink::PeerView& p : link->Peers())
     if (p.alive && p.telemetry.robot.value < config.robot.value) v.publish_tf = false;
   {
-    std::lock_guard<std::mutex> lock(session_mutex);
-    AddGraph(session.distilled(), Eigen::Isometry3d::Identity(), v);
-    for (std::size_t i = 0; i < session.peers(); ++i) {
-      const core::CollabPeerStats s = session.peer_stats(i);
-      const core::DistilledGraph* g = session.peer_graph(s.robot);
-      if (!s.merged || g == nullptr) continue;
-      const Eigen::Isometry3d T = session.T_self_robot(s.robot);
-      AddGraph(*g, T, v);
-      v.origins.push_back({FrameOf(s.robot), T});
-    }
+    // What the collab thread last took from the session: copied, never waited for across Match.
+    std::lock_guard<std::mutex> lock(ros_fleet_mutex);
+    v.walls = ros_fleet.walls;
+    v.rooms = ros_fleet.rooms;
+    v.origins = ros_fleet.origins;
   }
   const SteadyTime now = platform::SteadyNow();
   if (ros->cloud_wanted() &&

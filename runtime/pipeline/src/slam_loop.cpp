@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The SLAM thread: odometry and scans into the local S-Graph; every exchange period (sensor
-// time) the distilled graph and room descriptors go out through the session, and the newest
-// wall priors from the other robots come in. After the inputs end it keeps serving: it
+// time) the own map is prepared for the session (distilled graph, room descriptors, free space,
+// place clouds) and handed to the collab thread, and the newest wall priors from the other
+// robots come in. After the inputs end it keeps serving: it
 // publishes again when a peer asks for a resync or new priors arrive.
 #include <algorithm>
 #include <cmath>
@@ -24,7 +25,10 @@ constexpr double kOdometryMargin_s = 0.05;
 
 }  // namespace
 
-void Node::Impl::Exchange() {
+// Returns false when the last exchange still waits for the collab thread (busy in Match): then
+// nothing is prepared and the caller tries again after its next scan.
+bool Node::Impl::Exchange() {
+  const SteadyTime t0 = platform::SteadyNow();
   if (config.feedback) {
     bool fresh = false;
     {
@@ -46,29 +50,37 @@ void Node::Impl::Exchange() {
       }
     }
   }
-  std::uint32_t version = 0, walls = 0, rooms = 0;
-  {
-    std::lock_guard<std::mutex> lock(session_mutex);
-    static_cast<void>(session.Publish(mapper, *link));
-    const core::DistilledGraph& g = session.distilled();
-    version = g.version;
-    walls = static_cast<std::uint32_t>(g.walls.size());
-    rooms = static_cast<std::uint32_t>(g.rooms.size());
+  ExchangeSlot* slot = exchanges.Begin();
+  if (slot == nullptr) {
+    std::lock_guard<std::mutex> lock(status_mutex);
+    ++slam_status.exchanges_deferred;
+    return false;
   }
-  PublishRos();
-  const SteadyTime now = platform::SteadyNow();
-  for (const SteadyTime t : unpublished_keyframes) wire_ms.Add((now - t).seconds() * 1e3);
+  // The slot is neither posted nor being ingested: this thread's alone until it is posted.
+  slot->x.requests.clear();
+  {
+    std::lock_guard<std::mutex> lock(requests_mutex);
+    for (const core::PlaceRequest& q : requests_mailbox) static_cast<void>(slot->x.requests.try_push_back(q));
+    requests_mailbox.clear();
+  }
+  publisher.Prepare(mapper, slot->x);
+  slot->publisher = publisher.stats();
+  slot->keyframes.clear();
+  slot->keyframes.insert(slot->keyframes.end(), unpublished_keyframes.begin(), unpublished_keyframes.end());
   unpublished_keyframes.clear();
+  const core::DistilledGraph& g = publisher.graph();
+  exchanges.Post(slot);
+  // The collab thread takes it between its receive rounds (at most kReceiveWait) and Matches.
+  PublishRos();
+  exchange_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
   std::lock_guard<std::mutex> lock(status_mutex);
-  slam_status.graph_version = version;
-  slam_status.walls = walls;
-  slam_status.rooms = rooms;
-  slam_status.publishes += 1;
+  slam_status.walls = static_cast<std::uint32_t>(g.walls.size());
+  slam_status.rooms = static_cast<std::uint32_t>(g.rooms.size());
   slam_status.plane_priors = mapper.stats().plane_priors;
-  slam_status.wire_p50_ms = wire_ms.Percentile(0.5);
-  slam_status.wire_p99_ms = wire_ms.Percentile(0.99);
-  slam_status.wire_max_ms = wire_ms.Percentile(1.0);
-  slam_status.wire_samples = wire_ms.count();
+  slam_status.exchange_p50_ms = exchange_ms.Percentile(0.5);
+  slam_status.exchange_p99_ms = exchange_ms.Percentile(0.99);
+  slam_status.exchange_max_ms = exchange_ms.Percentile(1.0);
+  return true;
 }
 
 Node::Impl::Relocalising Node::Impl::RelocaliseOn(const ScanSlot& scan) {
@@ -147,6 +159,7 @@ void Node::Impl::ReleaseNewOdometry() {
 void Node::Impl::SlamLoop() {
   static_cast<void>(platform::SetCurrentThreadName("msg-slam"));
   double next_exchange_s = -1;
+  bool exchange_owed = false;
   SteadyTime next_sync = platform::SteadyNow() + Duration::FromSeconds(config.checkpoint_sync_s);
   const double inf = std::numeric_limits<double>::infinity();
   // Odometry into the mapper: in lock-step only what the next scan needs (the rest waits in
@@ -240,8 +253,8 @@ void Node::Impl::SlamLoop() {
       next_sync = platform::SteadyNow() + Duration::FromSeconds(config.checkpoint_sync_s);
     }
     if (next_exchange_s < 0) next_exchange_s = end_s + config.exchange_period_s;
-    if (end_s >= next_exchange_s || publish_now.exchange(false)) {
-      Exchange();
+    if (end_s >= next_exchange_s || exchange_owed || publish_now.exchange(false)) {
+      exchange_owed = !Exchange();  // not taken yet: again after the next scan
       while (next_exchange_s <= end_s) next_exchange_s += config.exchange_period_s;
     }
   }
@@ -251,17 +264,19 @@ void Node::Impl::SlamLoop() {
   static_cast<void>(mapper.Finish());
   Journal([](JournalWriter& j) { return j.Finish() && j.Sync(); });
   state = link::NodeState::kInputDone;
-  Exchange();
+  exchange_owed = !Exchange();
   const Duration period = Duration::FromSeconds(std::min(config.exchange_period_s, 1.0));
+  // Owed exchanges are tried again every 20 ms: the collab thread takes one between its rounds.
   while (!ShouldStop()) {
     {
       std::unique_lock<std::mutex> lock(wake_mutex);
-      wake_slam.wait_for(lock, std::chrono::nanoseconds(period.nanoseconds()),
+      wake_slam.wait_for(lock,
+                         std::chrono::nanoseconds(exchange_owed ? kWait.nanoseconds() : period.nanoseconds()),
                          [&] { return publish_now.load() || ShouldStop(); });
     }
     publish_now = false;
     if (ShouldStop()) break;
-    Exchange();
+    exchange_owed = !Exchange();
   }
 }
 

@@ -2,9 +2,12 @@
 // One robot's side of Multi S-Graphs, transport-agnostic: what the onboard node runs between
 // its local S-Graph and the radio link, and what msgraphs_collab runs between in-process robots.
 //
-// - Publish(mapper): distils the local graph and sends what changed since the last Publish, and
-//   the descriptor of every new or significantly changed room (its room cloud is kept to answer
-//   requests for it).
+// - Ingest(exchange): takes what the publisher (collab_publisher.hpp) prepared from the local
+//   S-Graph: sends the distilled graph's changes since the last exchange, the free-space summary
+//   when enough of it changed, the place clouds peers asked for, and the descriptor of every new
+//   or significantly changed room (its room cloud is kept to answer requests for it). The
+//   session never reads the local S-Graph: the node's SLAM thread prepares, the collab thread
+//   ingests, and neither waits for the other's work (PublishNow does both in one thread).
 // - Receive(type, bytes): decodes a peer's message (every decoder checks it; a malformed one
 //   is counted by type and dropped). A room cloud request is answered at once.
 // - Match(): proposes room pairs by Scan Context distance, requests the peer's room cloud for
@@ -17,12 +20,12 @@
 //   merge or a merged map changed. A merge that later evidence contradicts is undone.
 // - The fallback (place_evidence.hpp): a pair the rule leaves undecided between two transforms
 //   asks the peer for its points around a place that tells them apart, within a byte budget
-//   per peer; the points set the loser aside. A peer's place request is queued and answered
-//   at the next Publish (it needs the map).
+//   per peer; the points set the loser aside. A peer's place request is queued, taken for the
+//   next exchange (TakePlaceRequests: its cloud needs the map) and answered at its Ingest.
 //
 // Bounded: every store is sized at Init (capacities in CollabSessionConfig; the byte figure is
-// in stats()); what allocates after Init is Ceres, in Publish's wall marginals (Distiller) and
-// in Match's fine alignments' solves and the collaborative graph's rebuild and solve. Full stores refuse with a counter: a peer beyond max_peers is ignored, a room
+// in stats()); what allocates after Init is Ceres, in Match's fine alignments' solves and the
+// collaborative graph's rebuild and solve. Full stores refuse with a counter: a peer beyond max_peers is ignored, a room
 // beyond max_rooms gets no descriptor, a room cloud beyond max_room_points is not described,
 // a peer's descriptor beyond max_peer_rooms is dropped, matches beyond max_matches_per_peer are
 // dropped, the peer cloud cache evicts its oldest entry. Not thread-safe: the caller serialises.
@@ -40,6 +43,7 @@
 #include "msgraphs/core/collab/merge_rule.hpp"
 #include "msgraphs/core/collab/place_cloud.hpp"
 #include "msgraphs/core/collab/place_evidence.hpp"
+#include "msgraphs/core/collab/place_messages.hpp"
 #include "msgraphs/core/collab/room_descriptor.hpp"
 #include "msgraphs/core/collab/room_matcher.hpp"
 #include "msgraphs/core/collab/room_messages.hpp"
@@ -47,6 +51,9 @@
 #include "msgraphs/core/slam/local_mapper.hpp"
 
 namespace msgraphs::core {
+
+struct CollabExchange;
+struct CollabPublisherStats;
 
 enum class CollabMessageType : std::uint8_t {
   kDistilledGraph = 0,
@@ -89,6 +96,11 @@ struct CollabSessionConfig {
   std::size_t max_pending = 64;         ///< proposals waiting for a room cloud, per peer
   std::size_t max_matches_per_peer = 64;
   std::size_t cloud_cache = 16;  ///< peer room clouds kept for later proposals
+  /// One exchange (collab_publisher.hpp) carries at most this many rebuilt rooms sharing this
+  /// many points; a room beyond waits for the next exchange (CollabPublisherStats::rooms_deferred).
+  /// 16 of the largest rooms measured (5,800 points) fit.
+  std::size_t rooms_per_exchange = 16;
+  std::size_t room_points_per_exchange = 96000;
   std::size_t max_message_bytes = 1 << 20;
   /// A room's descriptor is rebuilt and sent again when its walls changed or its centre or size
   /// moved by more than this (its distilled entry follows every centimetre).
@@ -205,6 +217,7 @@ struct CollabSessionStats {
                 place_requests_refused = 0, place_requests_unanswered = 0, place_clouds_unsolicited = 0,
                 place_duels = 0, place_set_aside = 0;
   // Refusals of full stores (see the header comment).
+  std::uint64_t rooms_deferred = 0;  ///< rooms left for a later exchange (collab_publisher.hpp)
   std::uint64_t peers_refused = 0, rooms_refused = 0, room_clouds_too_large = 0,
                 descriptors_refused = 0, pending_refused = 0, matches_refused = 0,
                 cache_evictions = 0, descriptors_mismatched = 0, encode_failures = 0,
@@ -251,9 +264,15 @@ class CollabSession {
   /// this robot's map frame (the map frame is the first base pose, so minus the base height).
   Status Init(const CollabSessionConfig& config, const SGraphConfig& graph, double floor_z_map_m);
 
-  /// Distils and sends what changed; descriptors of new or changed rooms.
-  Status Publish(const LocalMapper& mapper, CollabOutbox& out);
-  /// The next Publish sends the whole graph and every descriptor again (a peer joined late).
+  /// Sends what changed in the own map that `exchange` carries (prepared by a CollabPublisher
+  /// initialised alike; its stats are copied into stats()); descriptors of rebuilt or unsent
+  /// rooms; the place clouds it built. Its free-space summary is swapped in (the exchange gets
+  /// the old one back). An exchange older than the last one is refused.
+  Status Ingest(CollabExchange& exchange, const CollabPublisherStats& publisher, CollabOutbox& out);
+  /// The peers' place requests the next exchange should answer, appended to `out`; the queue
+  /// is emptied. A request beyond the peer's byte budget is refused and counted.
+  void TakePlaceRequests(BoundedVector<PlaceRequest>& out);
+  /// The next Ingest sends the whole graph and every descriptor again (a peer joined late).
   void ResendAll();
 
   /// A message from the link. Malformed ones return the decoder's error and are counted.
@@ -287,7 +306,7 @@ class CollabSession {
   /// Merge decisions with sequence > `after`, oldest first, into `out`; returns how many. The log
   /// keeps the newest max_log entries (stats().log_dropped counts the rest).
   std::size_t MergeLog(std::uint64_t after, std::span<MergeLogEntry> out) const;
-  /// This robot's free-space summary as last built (empty before the first Publish).
+  /// This robot's free-space summary as last built (empty before the first Ingest).
   const FreeSpaceSummary& free_space() const;
 
   std::size_t peers() const;

@@ -5,7 +5,9 @@
 //
 // Versioned and incremental: each wall and room carries the graph version in which it last
 // changed by more than the resend thresholds, so the codec can send only what changed since
-// what a peer acknowledged. Its own stores are sized at Init. Update allocates: with
+// what a peer acknowledged. An Update that finds the S-Graph at the revision of the last one
+// (SGraphStats::revision) computes nothing. Its own stores are sized at
+// Init. Update allocates: with
 // `marginal_covariances` (the default) it asks the S-Graph for the walls' marginals, which
 // ceres::Covariance computes with heap memory of its own (SGraph::PlaneMarginals); without
 // them, Update allocates nothing.
@@ -50,6 +52,7 @@ class Distiller {
   const DistilledGraph& graph() const { return out_; }
   struct Stats {
     std::uint64_t marginal_updates = 0, marginal_failures = 0;
+    std::uint64_t unchanged = 0;  ///< Updates that found the S-Graph as it was (nothing computed)
   };
   const Stats& stats() const { return stats_; }
 
@@ -62,6 +65,8 @@ class Distiller {
   BoundedVector<std::uint32_t> eligible_;
   std::vector<Eigen::Matrix3d> marginals_;
   Stats stats_;
+  bool updated_once_ = false;
+  std::uint64_t revision_ = 0;  // the S-Graph's at the last Update
 };
 
 }  // namespace msgraphs::core

@@ -43,7 +43,7 @@ struct PlaceEvidenceConfig {
   float radius_m = 5.0f;
   std::size_t max_places_per_peer = 4;  ///< clouds held per peer (the oldest gives way)
   std::size_t max_asked_per_peer = 16;  ///< places asked for per peer (never asked again)
-  std::size_t max_requests_queued = 8;  ///< requests from peers awaiting the next Publish
+  std::size_t max_requests_queued = 8;  ///< requests from peers awaiting the next exchange
   /// A place is worth asking for where the two transforms lay it at least this far apart
   /// (five summary cells: far enough that they meet different surroundings).
   double min_separation_m = 1.0;

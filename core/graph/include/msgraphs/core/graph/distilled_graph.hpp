@@ -59,6 +59,20 @@ struct DistilledGraph {
     floor_z_m = 0;
     version = 0;
   }
+  /// Element by element into this graph's capacities (sized alike: no allocation; beyond
+  /// them, false and the rest left out).
+  bool CopyFrom(const DistilledGraph& other) {
+    Clear();
+    robot = other.robot;
+    version = other.version;
+    has_floor = other.has_floor;
+    floor_centre = other.floor_centre;
+    floor_z_m = other.floor_z_m;
+    bool all = true;
+    for (const DistilledWall& w : other.walls) all = walls.try_push_back(w) && all;
+    for (const DistilledRoom& r : other.rooms) all = rooms.try_push_back(r) && all;
+    return all;
+  }
   const DistilledWall* FindWall(std::uint32_t id) const {
     for (const DistilledWall& w : walls) {
       if (w.id == id) return &w;

@@ -151,6 +151,9 @@ struct SGraphStats {
   std::uint64_t rejected_missing_node = 0;  ///< factor to a node that does not exist (any more)
   std::uint64_t rejected_capacity = 0;
   std::uint64_t solves = 0, solves_not_converged = 0, solves_undone = 0;
+  /// Goes up at every call that may change the graph (its structure or its estimates): equal
+  /// revisions, the same graph (the distiller skips its work on it).
+  std::uint64_t revision = 0;
   /// Bytes of our own stores (fixed at Init). Ceres' problem grows with the graph, and the
   /// graph is bounded, so its size is bounded too; tools report the process peak.
   std::size_t store_bytes = 0;

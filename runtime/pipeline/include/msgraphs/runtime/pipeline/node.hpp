@@ -4,16 +4,21 @@
 //   LiDAR thread     Velodyne UDP or pcap -> assembled scans --[scan queue]--------+
 //   odometry thread  SocketCAN or candump -> encoder poses  --[odometry queue]-----+
 //                                                                                  v
-//   SLAM thread      LocalMapper (local S-Graph); every exchange period: CollabSession::Publish
-//                    through the link, and the latest wall priors from the other robots
-//   collab thread    FleetLink -> CollabSession::Receive / Match (room matching, fine alignment,
-//                    collaborative graph); resync requests; wall priors for the SLAM thread
+//   SLAM thread      LocalMapper (local S-Graph); every exchange period: CollabPublisher::Prepare
+//                    (distillation, room descriptors, free space, place clouds) into an exchange
+//                    for the collab thread, and the latest wall priors from the other robots
+//   collab thread    FleetLink -> CollabSession::Receive / Ingest (the exchange, sent through the
+//                    link) / Match (room matching, fine alignment, merge decision, collaborative
+//                    graph); resync requests; wall priors for the SLAM thread
 //   supervisor       (the caller's thread, Run): telemetry, status lines, the status LED,
 //                    exit conditions, the output files at the end
 //
-// The session is shared by the SLAM and collab threads under one mutex; the queues are the
-// only other meeting points. Queue capacities are in the configuration; a full queue drops
-// the newest element and counts it (live inputs) or holds the reader back (lock-step replay).
+// The SLAM thread never takes the session's mutex: it meets the collab thread only in small
+// mailboxes (the exchange, place requests, wall priors, the fleet's walls for the ROS view),
+// each held for a copy or a pointer swap, never across Match. When the collab thread has not
+// taken the last exchange yet, the SLAM thread does not wait: it tries again after its next
+// scan (counted). Queue capacities are in the configuration; a full queue drops the newest
+// element and counts it (live inputs) or holds the reader back (lock-step replay).
 #pragma once
 
 #include <atomic>
