@@ -4,8 +4,8 @@
 // per map (four walls each); arg 1: channels (one-direction alignments, the wall-pair families)
 // on or off.
 // And a place cloud built from a mapped hall (place_cloud.hpp): the fallback's answer to a
-// peer, built in CollabPublisher::Prepare (the node's SLAM thread). Arg 0: keyframes, all within reach of the
-// place (the worst case: a robot that walked the hall back and forth).
+// peer, built in CollabPublisher::Prepare (the node's SLAM thread). Arg 0: keyframes, all
+// within reach of the place (the worst case: a robot that walked the hall back and forth).
 #include <benchmark/benchmark.h>
 
 #include <cmath>

@@ -136,6 +136,13 @@ TEST(CollabPublisher, PreparingWithoutMarginalsAndIngestingAllocateNothing) {
   }
   ASSERT_EQ(r.exchange.requests.size(), 1u);
   {
+    // The peer asks again before the answer went out: taken once, not twice.
+    ASSERT_TRUE(r.session.Receive(CollabMessageType::kPlaceRequest, request, out));
+    BoundedVector<PlaceRequest> again(8);
+    r.session.TakePlaceRequests(again);
+    EXPECT_EQ(again.size(), 0u) << "in flight";
+  }
+  {
     test::AllocationScope scope;
     r.publisher.Prepare(r.mapper, r.exchange);
     prepare = scope.allocations();
@@ -154,6 +161,53 @@ TEST(CollabPublisher, PreparingWithoutMarginalsAndIngestingAllocateNothing) {
   EXPECT_EQ(out[CollabMessageType::kPlaceCloud], 1u);
   EXPECT_EQ(out[CollabMessageType::kRoomDescriptor], 1u);
   EXPECT_EQ(r.session.stats().place_requests_served, 1u);
+  // Answered: a retry that crossed the answer is not taken again.
+  ASSERT_TRUE(r.session.Receive(CollabMessageType::kPlaceRequest, request, out));
+  BoundedVector<PlaceRequest> retry(8);
+  r.session.TakePlaceRequests(retry);
+  EXPECT_EQ(retry.size(), 0u);
+}
+
+TEST(CollabPublisher, ARequestOfAnExchangeRefusedIsTakenAgain) {
+  Robot r;
+  ASSERT_NO_FATAL_FAILURE(r.Init(false));
+  CountingOutbox out;
+  {
+    CollabSessionConfig peer_config = r.config;
+    peer_config.robot = 2;
+    CollabSession other;
+    ASSERT_TRUE(other.Init(peer_config, r.mapper.config().graph, -r.mapper.config().base_height_m));
+    struct Forward final : CollabOutbox {
+      CollabSession* to = nullptr;
+      void Send(CollabMessageType type, std::uint16_t, std::span<const std::uint8_t> bytes) override {
+        CountingOutbox ignore;
+        static_cast<void>(to->Receive(type, bytes, ignore));
+      }
+    } forward;
+    forward.to = &r.session;
+    CollabPublisher publisher;
+    CollabExchange exchange;
+    ASSERT_TRUE(publisher.Init(peer_config, r.mapper.config().graph, -r.mapper.config().base_height_m));
+    ASSERT_TRUE(exchange.Init(peer_config));
+    ASSERT_TRUE(PublishNow(r.mapper, publisher, exchange, other, forward));
+  }
+  ASSERT_TRUE(PublishNow(r.mapper, r.publisher, r.exchange, r.session, out));  // version >= 1
+  std::vector<std::uint8_t> request(kPlaceRequestBytes);
+  ASSERT_TRUE(EncodePlaceRequest({2, 1, 7, Eigen::Vector2f(3.0f, 0.0f), 4.5f}, request));
+  ASSERT_TRUE(r.session.Receive(CollabMessageType::kPlaceRequest, request, out));
+  CollabExchange stale;
+  ASSERT_TRUE(stale.Init(r.config));
+  r.session.TakePlaceRequests(stale.requests);
+  ASSERT_EQ(stale.requests.size(), 1u);
+  r.publisher.Prepare(r.mapper, stale);
+  stale.graph.version = 0;  // out of order
+  out.Clear();
+  EXPECT_FALSE(r.session.Ingest(stale, r.publisher.stats(), out));
+  EXPECT_EQ(out[CollabMessageType::kPlaceCloud], 0u);
+  // Released: the peer's retry is taken and answered.
+  ASSERT_TRUE(r.session.Receive(CollabMessageType::kPlaceRequest, request, out));
+  ASSERT_TRUE(PublishNow(r.mapper, r.publisher, r.exchange, r.session, out));
+  EXPECT_EQ(out[CollabMessageType::kPlaceCloud], 1u);
 }
 
 }  // namespace

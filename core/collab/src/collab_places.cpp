@@ -81,35 +81,45 @@ Status CollabSession::Impl::ReceivePlaceCloud(std::span<const std::uint8_t> byte
   return Ok();
 }
 
-// Requests are taken for the next exchange where this robot's budget for that peer still holds
-// the largest cloud (reserved until the exchange sends the actual one), and a retry of the place
-// last answered is not served again.
+// Requests are taken for the next exchange while `out` has room (the rest stay queued for the
+// one after) and this robot's budget for that peer still holds the largest cloud (reserved until
+// the exchange is ingested); a retry of a place answered or in flight is not taken again.
 void CollabSession::TakePlaceRequests(BoundedVector<PlaceRequest>& out) {
   Impl& m = *impl_;
   const std::size_t largest = PlaceCloudEncodedSize(m.config.place_cloud.max_points);
-  for (const PlaceRequest& q : m.place_queue) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < m.place_queue.size(); ++i) {
+    const PlaceRequest q = m.place_queue[i];
     Impl::Peer* p = m.FindPeer(q.from);
     if (p == nullptr) continue;
     if (p->place_served && p->place_served_id == q.place) continue;  // a retry of one answered
+    if (p->place_in_flight && p->place_in_flight_id == q.place) continue;  // taken already
     if (p->place_bytes_out + p->place_bytes_reserved + largest > m.config.places.budget_bytes_per_peer) {
       ++m.stats.place_requests_refused;  // this peer's budget is spent: the request goes unanswered
       continue;
     }
-    if (!out.try_push_back(q)) break;  // sized alike: not reached
+    if (!out.try_push_back(q)) {
+      m.place_queue[kept++] = q;  // the next exchange takes it
+      continue;
+    }
     p->place_bytes_reserved += largest;
-    p->place_served = true;
-    p->place_served_id = q.place;
+    p->place_in_flight = true;
+    p->place_in_flight_id = q.place;
   }
-  m.place_queue.clear();
+  m.place_queue.resize_down(kept);
 }
 
-void CollabSession::Impl::ServePlaces(const CollabExchange& x, CollabOutbox& out) {
+// The taken requests' reservations are released; each is answered (and counted as served) only
+// when its cloud goes out.
+void CollabSession::Impl::ServePlaces(const CollabExchange& x, bool send, CollabOutbox& out) {
   const std::size_t largest = PlaceCloudEncodedSize(config.place_cloud.max_points);
   for (const CollabExchange::Place& place : x.places) {
     const PlaceRequest& q = place.request;
     Peer* p = FindPeer(q.from);
     if (p == nullptr) continue;
     p->place_bytes_reserved -= std::min<std::uint64_t>(p->place_bytes_reserved, largest);
+    if (p->place_in_flight && p->place_in_flight_id == q.place) p->place_in_flight = false;
+    if (!send) continue;  // the peer asks again
     const PlaceCloudHeader header{config.robot, q.from, q.place, q.centre_m, static_cast<float>(floor_z_m),
                                   PlaceCloudStep(place.radius_m)};
     auto n = EncodePlaceCloud(header, x.place_points.span().subspan(place.first, place.count), buffer);
@@ -118,6 +128,8 @@ void CollabSession::Impl::ServePlaces(const CollabExchange& x, CollabOutbox& out
       continue;
     }
     p->place_bytes_out += *n;
+    p->place_served = true;
+    p->place_served_id = q.place;
     ++stats.place_requests_served;
     Send(out, CollabMessageType::kPlaceCloud, q.from, *n);
   }

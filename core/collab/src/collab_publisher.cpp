@@ -53,6 +53,7 @@ Status CollabPublisher::Init(const CollabSessionConfig& config_in,
   if (auto s = place_builder_.Init(config.place_cloud); !s) return s;
   built_.assign(config.max_rooms, Built{});
   cloud_scratch_.Init(config.descriptor.max_points);
+  place_scratch_.Init(config.place_cloud.max_points);
   stats_ = {};
   return Ok();
 }
@@ -76,8 +77,8 @@ void CollabPublisher::Prepare(const LocalMapper& mapper, CollabExchange& out) {
     place.radius_m = std::min(q.radius_m, config_.places.radius_m);
     place.first = out.place_points.size();
     // Nothing stored there (a place never reached, or its clouds evicted): an empty cloud says so.
-    if (place_builder_.Build(mapper, q.centre_m.cast<double>(), place.radius_m, cloud_scratch_)) {
-      for (const Eigen::Vector3f& p : cloud_scratch_) {
+    if (place_builder_.Build(mapper, q.centre_m.cast<double>(), place.radius_m, place_scratch_)) {
+      for (const Eigen::Vector3f& p : place_scratch_) {
         if (!out.place_points.try_push_back(p)) break;
       }
     }
@@ -112,18 +113,15 @@ void CollabPublisher::PrepareRooms(const LocalMapper& mapper, CollabExchange& ou
       slot->stale = true;
     }
     if (!slot->stale) continue;
-    if (out.rooms.full()) {
-      ++stats_.rooms_deferred;
+    if (out.rooms.full() ||
+        out.room_points.size() + config_.max_room_points > out.room_points.capacity()) {
+      ++stats_.rooms_deferred;  // stays stale: built at the next exchange
       continue;
     }
     if (!builder_.Build(mapper, room, cloud_scratch_, descriptor_scratch_)) continue;
     stats_.room_points_peak = std::max(stats_.room_points_peak, cloud_scratch_.size());
     if (cloud_scratch_.size() > config_.max_room_points) {
       ++stats_.room_clouds_too_large;
-      continue;
-    }
-    if (out.room_points.size() + cloud_scratch_.size() > out.room_points.capacity()) {
-      ++stats_.rooms_deferred;  // stays stale: built again at the next exchange
       continue;
     }
     slot->used = true;

@@ -119,7 +119,8 @@ Status CollabSession::Receive(CollabMessageType type,
         return Error{Errc::kInvalidArgument, "room cloud: not requested"};
       }
       if (m.cloud_scratch.size() > m.config.max_room_points) {
-        ++m.stats.room_clouds_too_large;
+        ++m.peer_clouds_too_large;
+        m.stats.room_clouds_too_large = m.own_clouds_too_large + m.peer_clouds_too_large;
         return Error{Errc::kCapacityExceeded, "room cloud: more points than max_room_points"};
       }
       // Into the least recently used cache slot.

@@ -113,8 +113,9 @@ CollabSession::Impl::Peer* CollabSession::Impl::FindOrAddPeer(std::uint16_t robo
     p.place_pending = p.wants_place = false;
     p.place_pending_id = p.place_tries = p.next_place = 0;
     p.place_bytes_in = p.place_bytes_out = 0;
-    p.place_served = false;
-    p.place_served_id = 0;
+    p.place_served = p.place_in_flight = false;
+    p.place_served_id = p.place_in_flight_id = 0;
+    p.place_bytes_reserved = 0;
     p.stats = CollabPeerStats{};
     p.stats.robot = robot;
     ++stats.peers;
@@ -176,7 +177,7 @@ Status CollabSession::Init(const CollabSessionConfig& config_in,
   m.place_scratch.Init(config.place_cloud.max_points);
   m.set_aside.Init(8);
   m.place_views.assign(config.places.max_places_per_peer, PlaceView{});
-  bytes += 2 * config.place_cloud.max_raw_points * 12 + 3 * config.place_cloud.max_points * 12 +
+  bytes += 3 * config.place_cloud.max_points * 12 +
            config.free_space.max_cells * 9;
   bytes +=
       config.max_peers * (sizeof(Impl::Peer) + config.distiller.max_walls * sizeof(DistilledWall) +
@@ -232,22 +233,28 @@ Status CollabSession::Ingest(CollabExchange& x, const CollabPublisherStats& from
   m.stats.marginal_failures = from.marginal_failures;
   m.stats.free_space_build_failures = from.free_space_build_failures;
   m.stats.rooms_refused = from.rooms_refused;
-  m.stats.room_clouds_too_large = from.room_clouds_too_large;
+  m.own_clouds_too_large = from.room_clouds_too_large;
+  m.stats.room_clouds_too_large = m.own_clouds_too_large + m.peer_clouds_too_large;
   m.stats.rooms_deferred = from.rooms_deferred;
   m.stats.room_points_peak = from.room_points_peak;
-  if (x.graph.version < m.own_graph.version)
+  if (x.graph.version < m.own_graph.version) {
+    m.ServePlaces(x, false, out);  // reservations released; the peers ask again
     return Error{Errc::kInvalidArgument, "collab session: an exchange older than the last one"};
+  }
   DistilledGraph& g = m.own_graph;
   g.CopyFrom(x.graph);  // capacities sized alike
   g.robot = m.config.robot;
+  Status result = Ok();
   if (g.version > m.sent_version) {
-    auto n = EncodeDistilled(g, m.sent_version, m.buffer);
-    if (!n) {
+    // A graph that does not encode is counted and reported; the rest of the exchange still goes
+    // in (its rooms are built only once).
+    if (auto n = EncodeDistilled(g, m.sent_version, m.buffer); !n) {
       ++m.stats.encode_failures;
-      return n.error();
+      result = n.error();
+    } else {
+      m.Send(out, CollabMessageType::kDistilledGraph, 0, *n);
+      m.sent_version = g.version;
     }
-    m.Send(out, CollabMessageType::kDistilledGraph, 0, *n);
-    m.sent_version = g.version;
   }
   if (x.free_built) {
     // Swapped, not copied: the exchange takes the old summary, which its next Prepare rebuilds.
@@ -255,7 +262,7 @@ Status CollabSession::Ingest(CollabExchange& x, const CollabPublisherStats& from
     x.free_built = false;
     m.IngestFreeSpace(out);
   }
-  m.ServePlaces(x, out);
+  m.ServePlaces(x, true, out);
   for (const CollabExchange::Room& built : x.rooms) {
     Impl::OwnRoom* slot = m.FindOwn(built.id);
     if (slot == nullptr) {
@@ -292,7 +299,7 @@ Status CollabSession::Ingest(CollabExchange& x, const CollabPublisherStats& from
     m.Send(out, CollabMessageType::kRoomDescriptor, 0, *n);
     slot->sent = true;
   }
-  return Ok();
+  return result;
 }
 
 // The summary is rebuilt at every exchange and sent when enough of it changed.

@@ -128,6 +128,8 @@ struct CollabSession::Impl {
     std::uint64_t place_bytes_reserved = 0;  // requests taken for the next exchange, at the largest
     bool place_served = false;  // the last place this peer asked for was answered
     std::uint32_t place_served_id = 0;
+    bool place_in_flight = false;  // a place taken for an exchange not ingested yet
+    std::uint32_t place_in_flight_id = 0;
     PlanarTransform duel_first, duel_second;
     std::uint32_t solved_version = 0;  // its graph's version at the last solve
     Eigen::Isometry3d T_self_peer = Eigen::Isometry3d::Identity();
@@ -167,6 +169,9 @@ struct CollabSession::Impl {
   BoundedVector<PlanarTransform> set_aside;
   std::vector<PlaceView> place_views;  // the held places of one peer, for a decision
   std::uint64_t place_clock = 0;
+  // Own room clouds too large to describe (the publisher's count) and peers' too large to hold
+  // (Receive's): stats().room_clouds_too_large is their sum.
+  std::uint64_t own_clouds_too_large = 0, peer_clouds_too_large = 0;
 
   Peer* FindPeer(std::uint16_t robot) {
     for (Peer& p : peers) {
@@ -223,7 +228,7 @@ struct CollabSession::Impl {
   // collab_places.cpp
   Status ReceivePlaceRequest(std::span<const std::uint8_t> bytes);
   Status ReceivePlaceCloud(std::span<const std::uint8_t> bytes);
-  void ServePlaces(const CollabExchange& x, CollabOutbox& out);
+  void ServePlaces(const CollabExchange& x, bool send, CollabOutbox& out);
   void WeighPlaces(Peer& p, MergeInputs& in, MergeDecision& d);
   void AskForPlace(Peer& p, CollabOutbox& out);
 };

@@ -105,16 +105,10 @@ void Node::Impl::CollabLoop() {
     // The own map the SLAM thread prepared, and peers' place requests for its next one.
     IngestExchange();
     {
+      // Into the mailbox while it has room; the rest stay queued in the session.
       std::lock_guard<std::mutex> lock(session_mutex);
-      requests_taken.clear();
-      session.TakePlaceRequests(requests_taken);
-    }
-    if (!requests_taken.empty()) {
-      std::lock_guard<std::mutex> lock(requests_mutex);
-      for (const core::PlaceRequest& q : requests_taken) {
-        // Full only when the SLAM thread has not prepared for a while: the peer asks again.
-        if (!requests_mailbox.try_push_back(q)) requests_dropped.fetch_add(1, std::memory_order_relaxed);
-      }
+      std::lock_guard<std::mutex> requests_lock(requests_mutex);
+      session.TakePlaceRequests(requests_mailbox);
     }
     pending_change = pending_change || changed;
     bool origins_changed = false;

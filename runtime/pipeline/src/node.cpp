@@ -124,7 +124,6 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
     slot.keyframes.reserve(4096);
   }
   m.requests_mailbox.Init(config.collab.places.max_requests_queued);
-  m.requests_taken.Init(config.collab.places.max_requests_queued);
   m.priors_mailbox.resize(config.mapper.max_plane_priors);
   m.priors_scratch.resize(config.mapper.max_plane_priors);
   m.priors_scratch_collab.resize(config.mapper.max_plane_priors);
@@ -396,6 +395,9 @@ int Node::Run(const std::atomic<bool>& stop) {
   m.wake_slam.notify_all();
   for (std::thread& t : m.threads) t.join();
   m.threads.clear();
+  // The last exchange the SLAM thread posted (after its final solve) goes out and into the
+  // outputs: the collab thread may have stopped before taking it.
+  m.IngestExchange();
   if (m.led) m.led->SetHealth(drivers::gpio::Health::kOff, platform::SteadyNow());
   m.PrintStatus((platform::SteadyNow() - m.started).seconds());
   m.WriteOutputs();

@@ -112,13 +112,14 @@ struct Node::Impl {
 
   // SLAM (owned by the SLAM thread once running).
   core::LocalMapper mapper;
-  LatencyWindow keyframe_ms{4096}, wire_ms{4096};
+  LatencyWindow keyframe_ms{4096};  ///< SLAM thread
+  LatencyWindow wire_ms{4096};      ///< collab thread, under status_mutex
   std::vector<SteadyTime> unpublished_keyframes;  ///< last-packet times since the last Publish
   mutable std::mutex status_mutex;
   SlamStatus slam_status;
 
   // The collaborative side: the session under session_mutex (the collab thread; the supervisor
-  // reads it for telemetry and at exit). The SLAM thread never takes it.
+  // after the threads ended). The SLAM thread never takes it.
   mutable std::mutex session_mutex;
   core::CollabSession session;
   // The own map for the session: prepared by the SLAM thread (publisher), ingested by the collab
@@ -131,13 +132,15 @@ struct Node::Impl {
     core::CollabPublisherStats publisher;  ///< the publisher's, when it was prepared
   };
   Handover<ExchangeSlot> exchanges;
-  /// Collab thread: the posted exchange, if any, into the session and out through the link.
+  /// Collab thread (and the supervisor once the threads ended): the posted exchange, if any,
+  /// into the session and out through the link.
   void IngestExchange();
-  // Peers' place requests the session let through, for the next exchange (collab -> SLAM).
+  // Peers' place requests the session let through, for the next exchange (collab -> SLAM; the
+  // collab thread takes requests_mutex inside session_mutex, the SLAM thread alone).
   std::mutex requests_mutex;
-  BoundedVector<core::PlaceRequest> requests_mailbox, requests_taken;
-  std::atomic<std::uint64_t> requests_dropped{0};  ///< the mailbox full (the peer asks again)
-  // Every robot's walls and rooms in this robot's frame, for the ROS view (collab -> SLAM).
+  BoundedVector<core::PlaceRequest> requests_mailbox;
+  // The merged robots' walls, rooms and origins in this robot's frame, for the ROS view
+  // (collab -> SLAM; the own map the SLAM thread draws from the publisher).
   std::mutex ros_fleet_mutex;
   link::RosMapView ros_fleet, ros_fleet_scratch;
   /// Collab thread, under session_mutex: ros_fleet from the session.

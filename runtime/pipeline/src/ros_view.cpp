@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The SLAM thread's view of the collaborative map for the ROS 2 topics: this robot's keyframes
-// and every merged robot's walls and rooms, brought into this robot's map frame. The walls and
-// rooms come from the session, which the collab thread owns: it refreshes a copy after each
-// exchange and each Match that changed something, and the SLAM thread reads the copy.
+// and every merged robot's walls and rooms, brought into this robot's map frame. The own walls
+// and rooms come from the publisher (SLAM thread); the other robots' from the session, which the
+// collab thread owns: it refreshes a copy after each exchange and each Match that changed
+// something, and the SLAM thread reads the copy.
 #include <algorithm>
 #include <cmath>
 
@@ -42,7 +43,6 @@ void Node::Impl::RefreshRosFleet() {
   f.walls.clear();
   f.rooms.clear();
   f.origins.clear();
-  AddGraph(session.distilled(), Eigen::Isometry3d::Identity(), f);
   for (std::size_t i = 0; i < session.peers(); ++i) {
     const core::CollabPeerStats s = session.peer_stats(i);
     const core::DistilledGraph* g = session.peer_graph(s.robot);
@@ -82,9 +82,10 @@ void Node::Impl::PublishRos() {
     if (p.alive && p.telemetry.robot.value < config.robot.value) v.publish_tf = false;
   {
     // What the collab thread last took from the session: copied, never waited for across Match.
+    AddGraph(publisher.graph(), Eigen::Isometry3d::Identity(), v);  // the own map, as just prepared
     std::lock_guard<std::mutex> lock(ros_fleet_mutex);
-    v.walls = ros_fleet.walls;
-    v.rooms = ros_fleet.rooms;
+    v.walls.insert(v.walls.end(), ros_fleet.walls.begin(), ros_fleet.walls.end());
+    v.rooms.insert(v.rooms.end(), ros_fleet.rooms.begin(), ros_fleet.rooms.end());
     v.origins = ros_fleet.origins;
   }
   const SteadyTime now = platform::SteadyNow();

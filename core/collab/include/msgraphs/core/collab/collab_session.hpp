@@ -97,10 +97,12 @@ struct CollabSessionConfig {
   std::size_t max_matches_per_peer = 64;
   std::size_t cloud_cache = 16;  ///< peer room clouds kept for later proposals
   /// One exchange (collab_publisher.hpp) carries at most this many rebuilt rooms sharing this
-  /// many points; a room beyond waits for the next exchange (CollabPublisherStats::rooms_deferred).
-  /// 16 of the largest rooms measured (5,800 points) fit.
-  std::size_t rooms_per_exchange = 16;
-  std::size_t room_points_per_exchange = 96000;
+  /// many points; a room beyond waits for the next exchange (CollabPublisherStats::rooms_deferred;
+  /// a room is built only when max_room_points still fit). Every own room at once, 64 of the
+  /// largest measured (5,800 points): a loop closure that moves every room rebuilds them all.
+  /// About 9 MB per exchange; the node holds two.
+  std::size_t rooms_per_exchange = 64;
+  std::size_t room_points_per_exchange = 384000;
   std::size_t max_message_bytes = 1 << 20;
   /// A room's descriptor is rebuilt and sent again when its walls changed or its centre or size
   /// moved by more than this (its distilled entry follows every centimetre).
@@ -267,10 +269,14 @@ class CollabSession {
   /// Sends what changed in the own map that `exchange` carries (prepared by a CollabPublisher
   /// initialised alike; its stats are copied into stats()); descriptors of rebuilt or unsent
   /// rooms; the place clouds it built. Its free-space summary is swapped in (the exchange gets
-  /// the old one back). An exchange older than the last one is refused.
+  /// the old one back). A distilled graph that does not encode returns the error after the rest
+  /// went in. An exchange older than the last one is refused whole (exchanges out of order are
+  /// the caller's bug: its rebuilt rooms are lost until they change again; its place requests'
+  /// reservations are released and the peers ask again).
   Status Ingest(CollabExchange& exchange, const CollabPublisherStats& publisher, CollabOutbox& out);
-  /// The peers' place requests the next exchange should answer, appended to `out`; the queue
-  /// is emptied. A request beyond the peer's byte budget is refused and counted.
+  /// The peers' place requests the next exchange should answer, appended to `out` while it has
+  /// room (the rest stay queued). A request beyond the peer's byte budget is refused and counted;
+  /// a retry of a place answered, or taken and not yet ingested, is not taken again.
   void TakePlaceRequests(BoundedVector<PlaceRequest>& out);
   /// The next Ingest sends the whole graph and every descriptor again (a peer joined late).
   void ResendAll();

@@ -5,11 +5,12 @@
 // it. The lock is held for a pointer's assignment only, never across either side's work.
 //
 // The node hands the own map (CollabExchange) from the SLAM thread to the collab thread with
-// it: a collab thread busy in Match for seconds holds at most the slot it took, and the SLAM
-// thread's next exchange goes into the other one. While a posted slot waits, Begin returns
-// nullptr at once: the producer does not overwrite what the consumer has not seen, and tries
-// again later (the node after its next scan). The slots are the caller's to size (slots()),
-// before the threads start; nothing here allocates.
+// it: while the collab thread works on the slot it took (sending it), the SLAM thread's next
+// exchange goes into the other one; while a posted slot waits (the collab thread busy in a
+// Match of seconds), Begin returns nullptr at once: the producer does not overwrite what the
+// consumer has not seen, and tries again later (the node after its next scan). Neither ever
+// waits for the other's work. The slots are the caller's to size (slots()), before the threads
+// start; nothing here allocates.
 #pragma once
 
 #include <array>
