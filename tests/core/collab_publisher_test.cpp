@@ -47,6 +47,29 @@ struct Robot {
   }
 };
 
+// Robot 2's first exchange (the same map) reaches `r`: a peer must be known for its place
+// requests to count.
+void IntroducePeer(Robot& r) {
+  CollabSessionConfig peer_config = r.config;
+  peer_config.robot = 2;
+  const double floor = -r.mapper.config().base_height_m;
+  CollabSession other;
+  ASSERT_TRUE(other.Init(peer_config, r.mapper.config().graph, floor));
+  struct Forward final : CollabOutbox {
+    CollabSession* to = nullptr;
+    void Send(CollabMessageType type, std::uint16_t, std::span<const std::uint8_t> bytes) override {
+      CountingOutbox ignore;
+      static_cast<void>(to->Receive(type, bytes, ignore));
+    }
+  } forward;
+  forward.to = &r.session;
+  CollabPublisher publisher;
+  CollabExchange exchange;
+  ASSERT_TRUE(publisher.Init(peer_config, r.mapper.config().graph, floor));
+  ASSERT_TRUE(exchange.Init(peer_config));
+  ASSERT_TRUE(PublishNow(r.mapper, publisher, exchange, other, forward));
+}
+
 TEST(CollabPublisher, WhatAnExchangeCarriesGoesOutOnceAndAgainAfterResendAll) {
   Robot r;
   ASSERT_NO_FATAL_FAILURE(r.Init(true));
@@ -100,28 +123,7 @@ TEST(CollabPublisher, PreparingWithoutMarginalsAndIngestingAllocateNothing) {
   ASSERT_NO_FATAL_FAILURE(r.Init(false));
   // A peer's place request, taken for the exchange: the place cloud is built in Prepare.
   CountingOutbox out;
-  {
-    // The peer must be known (its graph or descriptors reached us) for its request to count.
-    CollabSessionConfig peer_config = r.config;
-    peer_config.robot = 2;
-    Robot peer;
-    ASSERT_NO_FATAL_FAILURE(peer.Init(false));
-    CollabSession other;
-    ASSERT_TRUE(other.Init(peer_config, peer.mapper.config().graph, -peer.mapper.config().base_height_m));
-    struct Forward final : CollabOutbox {
-      CollabSession* to = nullptr;
-      void Send(CollabMessageType type, std::uint16_t, std::span<const std::uint8_t> bytes) override {
-        CountingOutbox ignore;
-        static_cast<void>(to->Receive(type, bytes, ignore));
-      }
-    } forward;
-    forward.to = &r.session;
-    CollabPublisher publisher;
-    CollabExchange exchange;
-    ASSERT_TRUE(publisher.Init(peer_config, peer.mapper.config().graph, -peer.mapper.config().base_height_m));
-    ASSERT_TRUE(exchange.Init(peer_config));
-    ASSERT_TRUE(PublishNow(peer.mapper, publisher, exchange, other, forward));
-  }
+  ASSERT_NO_FATAL_FAILURE(IntroducePeer(r));
   ASSERT_EQ(r.session.peers(), 1u);
   std::vector<std::uint8_t> request(kPlaceRequestBytes);
   ASSERT_TRUE(EncodePlaceRequest({2, 1, 7, Eigen::Vector2f(3.0f, 0.0f), 4.5f}, request));
@@ -172,25 +174,7 @@ TEST(CollabPublisher, ARequestOfAnExchangeRefusedIsTakenAgain) {
   Robot r;
   ASSERT_NO_FATAL_FAILURE(r.Init(false));
   CountingOutbox out;
-  {
-    CollabSessionConfig peer_config = r.config;
-    peer_config.robot = 2;
-    CollabSession other;
-    ASSERT_TRUE(other.Init(peer_config, r.mapper.config().graph, -r.mapper.config().base_height_m));
-    struct Forward final : CollabOutbox {
-      CollabSession* to = nullptr;
-      void Send(CollabMessageType type, std::uint16_t, std::span<const std::uint8_t> bytes) override {
-        CountingOutbox ignore;
-        static_cast<void>(to->Receive(type, bytes, ignore));
-      }
-    } forward;
-    forward.to = &r.session;
-    CollabPublisher publisher;
-    CollabExchange exchange;
-    ASSERT_TRUE(publisher.Init(peer_config, r.mapper.config().graph, -r.mapper.config().base_height_m));
-    ASSERT_TRUE(exchange.Init(peer_config));
-    ASSERT_TRUE(PublishNow(r.mapper, publisher, exchange, other, forward));
-  }
+  ASSERT_NO_FATAL_FAILURE(IntroducePeer(r));
   ASSERT_TRUE(PublishNow(r.mapper, r.publisher, r.exchange, r.session, out));  // version >= 1
   std::vector<std::uint8_t> request(kPlaceRequestBytes);
   ASSERT_TRUE(EncodePlaceRequest({2, 1, 7, Eigen::Vector2f(3.0f, 0.0f), 4.5f}, request));
