@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The S-Graph's public API; its state and shared helpers are in s_graph_impl.hpp, and
-// sparsification in s_graph_sparsify.cpp.
+// The S-Graph's public API; its state and shared helpers are in s_graph_impl.hpp, the solves
+// in s_graph_solve.cpp and sparsification in s_graph_sparsify.cpp.
 #include "msgraphs/core/graph/s_graph.hpp"
 
 #include <ceres/ceres.h>
@@ -252,7 +252,7 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
   if (!slot) return slot.error();
   m.EnsurePlaneInProblem(p);
   auto* functor = new sgraph::PlaneResidual{z.basis_u, z.basis_v, z.d, sqrt_information};
-  auto* cost = new ceres::AutoDiffCostFunction<sgraph::PlaneResidual, 3, 4, 3, 3, 1>(functor);
+  auto* cost = new sgraph::PlaneCost(functor);
   KeyframeNode& k = m.keyframes[keyframe];
   m.factors[static_cast<std::size_t>(*slot)].id =
       m.problem->AddResidualBlock(cost, m.huber_plane.get(), k.q, k.t, p.n, p.d);
@@ -475,96 +475,6 @@ Status SGraph::AddFloorRoom(std::uint32_t room) {
   return Ok();
 }
 
-Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
-  Impl& m = *impl_;
-  ++m.stats.revision;  // every call that may change the graph
-  SGraphSolveReport report;
-  report.kind = kind;
-  if (m.active_factors == 0) {
-    report.usable = report.converged = true;  // nothing to solve
-    return report;
-  }
-  // Which nodes move. Local: the newest keyframes, the planes they saw, the rooms on those
-  // planes. Full: everything but the origin.
-  std::int32_t window_start = m.newest;
-  if (kind == SolveKind::kLocal) {
-    for (std::size_t i = 1; i < m.config.local_window_keyframes; ++i) {
-      const std::int32_t prev = m.keyframes[static_cast<std::size_t>(window_start)].prev;
-      if (prev == kNone) break;
-      window_start = prev;
-    }
-  } else {
-    window_start = m.origin;
-  }
-  bool in_window = false;
-  std::size_t free_keyframes = 0;
-  // Walk in time order; the window is the tail of the list.
-  for (std::int32_t k = m.origin; k != kNone; k = m.keyframes[static_cast<std::size_t>(k)].next) {
-    if (k == window_start) in_window = true;
-    const bool free = in_window && k != m.origin;
-    KeyframeNode& node = m.keyframes[static_cast<std::size_t>(k)];
-    m.SetFree(node.q, free);
-    m.SetFree(node.t, free);
-    free_keyframes += free ? 1u : 0u;
-  }
-  // A plane is free when its newest observer is: keyframe slots are reused, so compare stamps.
-  const double window_stamp = m.keyframes[static_cast<std::size_t>(window_start)].stamp_s;
-  for (std::size_t i = 0; i < m.plane_count; ++i) {
-    PlaneNode& p = m.planes[i];
-    if (!p.in_problem) continue;
-    const std::uint32_t last = p.info.last_keyframe;
-    const bool free =
-        kind == SolveKind::kFull || (last < m.keyframe_high_water && m.keyframes[last].active &&
-                                     m.keyframes[last].stamp_s >= window_stamp);
-    m.SetFree(p.n, free);
-    m.SetFree(p.d, free);
-  }
-  for (std::size_t i = 0; i < m.room_count; ++i) {
-    RoomNode& r = m.rooms[i];
-    if (!r.in_problem) continue;
-    bool free = kind == SolveKind::kFull;
-    const int walls = r.info.shape == RoomShape::kFourWall ? 4 : 2;
-    for (int w = 0; w < walls && !free; ++w) {
-      const auto& plane =
-          m.planes[static_cast<std::size_t>(r.info.walls[static_cast<std::size_t>(w)])];
-      free = !m.problem->IsParameterBlockConstant(const_cast<double*>(plane.d));
-    }
-    m.SetFree(r.c, free);
-  }
-  if (m.floor_active) m.SetFree(m.floor_c, kind == SolveKind::kFull);
-
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  options.max_num_iterations =
-      kind == SolveKind::kLocal ? m.config.local_max_iterations : m.config.full_max_iterations;
-  options.max_solver_time_in_seconds =
-      kind == SolveKind::kLocal ? m.config.local_max_seconds : m.config.full_max_seconds;
-  options.num_threads = 1;  // core owns no threads
-  options.function_tolerance = 1e-7;
-  options.logging_type = ceres::SILENT;
-  m.Snapshot(false);
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, m.problem.get(), &summary);
-  ++m.stats.solves;
-  report.iterations = static_cast<int>(summary.iterations.size());
-  report.initial_cost = summary.initial_cost;
-  report.final_cost = summary.final_cost;
-  report.seconds = summary.total_time_in_seconds;
-  report.free_keyframes = free_keyframes;
-  report.converged = summary.termination_type == ceres::CONVERGENCE;
-  report.usable = (summary.termination_type == ceres::CONVERGENCE ||
-                   summary.termination_type == ceres::NO_CONVERGENCE ||
-                   summary.termination_type == ceres::USER_SUCCESS) &&
-                  std::isfinite(summary.final_cost) && m.StateFinite();
-  if (!report.converged) ++m.stats.solves_not_converged;
-  if (!report.usable) {
-    m.Snapshot(true);  // a failed solve leaves the graph as it was
-    ++m.stats.solves_undone;
-  }
-  return report;
-}
-
 std::size_t SGraph::keyframe_slots() const { return impl_->keyframe_high_water; }
 bool SGraph::keyframe_active(std::uint32_t id) const { return impl_->ValidKeyframe(id); }
 Eigen::Isometry3d SGraph::keyframe_pose(std::uint32_t id) const {
@@ -600,23 +510,8 @@ Status SGraph::PlaneMarginals(std::span<const std::uint32_t> ids,
     blocks.emplace_back(p.d, p.d);
   }
   if (ids.empty()) return Ok();
-  // A local solve leaves the nodes outside its window constant, and a constant block has no
-  // covariance: free everything but the origin, as a full solve does (every Solve sets the
-  // flags it needs again).
-  for (std::int32_t k = m.origin; k != kNone; k = m.keyframes[static_cast<std::size_t>(k)].next) {
-    KeyframeNode& node = m.keyframes[static_cast<std::size_t>(k)];
-    m.SetFree(node.q, k != m.origin);
-    m.SetFree(node.t, k != m.origin);
-  }
-  for (std::size_t i = 0; i < m.plane_count; ++i) {
-    if (!m.planes[i].in_problem) continue;
-    m.SetFree(m.planes[i].n, true);
-    m.SetFree(m.planes[i].d, true);
-  }
-  for (std::size_t i = 0; i < m.room_count; ++i) {
-    if (m.rooms[i].in_problem) m.SetFree(m.rooms[i].c, true);
-  }
-  if (m.floor_active) m.SetFree(m.floor_c, true);
+  // Every block but the origin's is variable in the graph's problem (local solves move a
+  // window problem of their own), so the covariance is over the whole graph.
   ceres::Covariance::Options options;
   options.algorithm_type = ceres::SPARSE_QR;
   options.num_threads = 1;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The S-Graph's private state (core_graph only): node and factor stores sized at Init, the
-// persistent Ceres problem, and the helpers that s_graph.cpp and s_graph_sparsify.cpp share.
+// persistent Ceres problem, and the helpers that s_graph.cpp, s_graph_solve.cpp and
+// s_graph_sparsify.cpp share.
 #pragma once
 
 #include <ceres/ceres.h>
@@ -49,6 +50,12 @@ struct PlaneNode {
   double d[1] = {0};
   MapPlane info;
   bool in_problem = false;
+  bool window_free = false;  // moves in the current local solve (CollectWindow)
+  // Its observations by keyframes the local solve holds, summed into one quadratic in
+  // x = [n; d] (s_graph_solve.cpp): x' H x - 2 g' x.
+  Eigen::Matrix4d held_H = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d held_g = Eigen::Vector4d::Zero();
+  std::uint32_t held_observations = 0;
 };
 
 struct RoomNode {
@@ -106,6 +113,8 @@ inline Eigen::Isometry3d Fuse(const Eigen::Isometry3d& Z_a,
 
 // How every relative factor is built: sparsification reads a measurement back from its functor.
 using RelativePoseCost = ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>;
+// How every keyframe-to-plane factor is built: the local solve reads its measurement back.
+using PlaneCost = ceres::AutoDiffCostFunction<PlaneResidual, 3, 4, 3, 3, 1>;
 
 }  // namespace sgraph
 
@@ -142,6 +151,27 @@ struct SGraph::Impl {
 
   std::vector<double> snapshot;  // parameter values before a solve, to undo a bad one
   SGraphStats stats;
+
+  // The local solve's window problem (s_graph_solve.cpp): built per local solve from the
+  // residual blocks on the window's nodes, and gone after it. The vectors keep their capacity.
+  std::unique_ptr<ceres::Problem> window;
+  std::vector<double*> window_free;  // the window's free parameter blocks, sorted
+  std::vector<std::pair<const double*, std::uint32_t>> window_free_planes;  // normal block, id
+  std::vector<ceres::ResidualBlockId> window_residuals, scratch_residuals;
+  std::vector<double*> scratch_blocks;
+  std::size_t window_residual_count = 0;  // residual blocks the last window problem held
+  std::vector<std::unique_ptr<ceres::CostFunction>> window_costs;  // the held observations' sums
+  // Which nodes move in a local solve: fills window_free; returns the free keyframes.
+  std::size_t CollectWindow();
+  void BuildWindowProblem();
+  // Snapshot (restore: put back) and finiteness of the window's free blocks only. The snapshot
+  // buffer holds every block of the graph, so it holds the window's.
+  void WindowSnapshot(bool restore);
+  bool WindowFinite() const;
+  // Adds one held keyframe's observation of a free plane to the plane's held_H / held_g.
+  void SumHeldObservation(const sgraph::PlaneCost& cost,
+                          const std::vector<double*>& blocks,
+                          const ceres::LossFunction* loss);
 
   bool ValidKeyframe(std::uint32_t id) const {
     return id < keyframe_high_water && keyframes[id].active;
@@ -330,13 +360,6 @@ struct SGraph::Impl {
       if (!std::isfinite(rooms[k].c[0]) || !std::isfinite(rooms[k].c[1])) return false;
     }
     return std::isfinite(floor_c[0]) && std::isfinite(floor_c[1]);
-  }
-
-  void SetFree(double* block, bool free) {
-    if (!problem->HasParameterBlock(block)) return;
-    const bool constant = problem->IsParameterBlockConstant(block);
-    if (free && constant) problem->SetParameterBlockVariable(block);
-    if (!free && !constant) problem->SetParameterBlockConstant(block);
   }
 };
 

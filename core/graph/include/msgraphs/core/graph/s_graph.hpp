@@ -151,6 +151,9 @@ struct SGraphStats {
   std::uint64_t rejected_missing_node = 0;  ///< factor to a node that does not exist (any more)
   std::uint64_t rejected_capacity = 0;
   std::uint64_t solves = 0, solves_not_converged = 0, solves_undone = 0;
+  /// The most residual blocks a local solve's window problem held (its cost follows this, not
+  /// the graph's size).
+  std::size_t window_residuals_peak = 0;
   /// Goes up at every call that may change the graph (its structure or its estimates): equal
   /// revisions, the same graph (the distiller skips its work on it).
   std::uint64_t revision = 0;

@@ -1,0 +1,271 @@
+// SPDX-License-Identifier: MIT
+// The S-Graph's two solves (docs/s-graph.md, "Solves").
+//
+// The graph's Ceres problem holds every node and factor, and every block in it is variable but
+// the origin's: a full solve hands it to Ceres as it is. A local solve does not: Ceres prepares
+// the whole problem it is given on every Solve (it walks every residual block to drop the ones
+// on constant blocks), so a local solve on that problem cost in proportion to the whole graph,
+// 10 ms a keyframe at 500 keyframes and 30 at 2,000, for the same 20 keyframes moving. A local
+// solve builds a window problem instead: the residual blocks that touch a node of the window,
+// sharing the graph's cost functions, losses, manifolds and parameter memory, with every other
+// node they touch held constant. That is the program Ceres would have reduced the whole
+// problem to, with one change: a free plane's observations by held keyframes (the floor's, by
+// every keyframe) are summed into one exact quadratic prior. So the solution is the same (the
+// held observations' Huber kernels are evaluated once, at the current estimate), and its cost
+// follows the window, not the graph.
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "msgraphs/core/graph/s_graph.hpp"
+#include "s_graph_impl.hpp"
+#include "s_graph_quadratic_prior.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+ceres::Solver::Options SolverOptions(const SGraphConfig& config, SolveKind kind) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  options.max_num_iterations =
+      kind == SolveKind::kLocal ? config.local_max_iterations : config.full_max_iterations;
+  options.max_solver_time_in_seconds =
+      kind == SolveKind::kLocal ? config.local_max_seconds : config.full_max_seconds;
+  options.num_threads = 1;  // core owns no threads
+  options.function_tolerance = 1e-7;
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+}  // namespace
+
+std::size_t SGraph::Impl::CollectWindow() {
+  window_free.clear();
+  window_free_planes.clear();
+  // The newest keyframes, the origin never among them.
+  std::int32_t window_start = newest;
+  std::size_t free_keyframes = 0;
+  for (std::int32_t k = newest; k != kNone && free_keyframes < config.local_window_keyframes;
+       k = keyframes[static_cast<std::size_t>(k)].prev) {
+    window_start = k;
+    if (k == origin) break;
+    KeyframeNode& node = keyframes[static_cast<std::size_t>(k)];
+    window_free.push_back(node.q);
+    window_free.push_back(node.t);
+    ++free_keyframes;
+  }
+  // A plane moves when its newest observer does: keyframe slots are reused, so compare stamps.
+  const double window_stamp = keyframes[static_cast<std::size_t>(window_start)].stamp_s;
+  for (std::size_t i = 0; i < plane_count; ++i) {
+    PlaneNode& p = planes[i];
+    if (!p.in_problem) continue;
+    const std::uint32_t last = p.info.last_keyframe;
+    const bool free = last < keyframe_high_water && keyframes[last].active &&
+                      keyframes[last].stamp_s >= window_stamp;
+    p.window_free = free;
+    if (!free) continue;
+    window_free_planes.emplace_back(p.n, static_cast<std::uint32_t>(i));
+    window_free.push_back(p.n);
+    window_free.push_back(p.d);
+  }
+  // A room moves with any of its walls; the floor is held.
+  for (std::size_t i = 0; i < room_count; ++i) {
+    RoomNode& r = rooms[i];
+    if (!r.in_problem) continue;
+    const int walls = r.info.shape == RoomShape::kFourWall ? 4 : 2;
+    bool free = false;
+    for (int w = 0; w < walls && !free; ++w)
+      free = planes[static_cast<std::size_t>(r.info.walls[static_cast<std::size_t>(w)])]
+                 .window_free;
+    if (free) window_free.push_back(r.c);
+  }
+  std::sort(window_free.begin(), window_free.end());
+  std::sort(window_free_planes.begin(), window_free_planes.end());
+  return free_keyframes;
+}
+
+void SGraph::Impl::BuildWindowProblem() {
+  ceres::Problem::Options options;
+  // The graph's problem owns them all; the window only borrows (its own sums: window_costs).
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  window = std::make_unique<ceres::Problem>(options);
+  window_costs.clear();
+  const auto is_free = [this](const double* block) {
+    return std::binary_search(window_free.begin(), window_free.end(), block);
+  };
+  const auto add_block = [this, &is_free](double* block) {
+    if (window->HasParameterBlock(block)) return;
+    window->AddParameterBlock(block, problem->ParameterBlockSize(block),
+                              const_cast<ceres::Manifold*>(problem->GetManifold(block)));
+    if (!is_free(block) || problem->IsParameterBlockConstant(block))
+      window->SetParameterBlockConstant(block);
+  };
+  // Every residual block on a free node, once.
+  window_residuals.clear();
+  for (double* block : window_free) {
+    problem->GetResidualBlocksForParameterBlock(block, &scratch_residuals);
+    window_residuals.insert(window_residuals.end(), scratch_residuals.begin(),
+                            scratch_residuals.end());
+  }
+  std::sort(window_residuals.begin(), window_residuals.end());
+  window_residuals.erase(std::unique(window_residuals.begin(), window_residuals.end()),
+                         window_residuals.end());
+  for (const auto& [n, i] : window_free_planes) {
+    planes[i].held_H.setZero();
+    planes[i].held_g.setZero();
+    planes[i].held_observations = 0;
+  }
+  std::size_t kept = 0;
+  for (ceres::ResidualBlockId id : window_residuals) {
+    problem->GetParameterBlocksForResidualBlock(id, &scratch_blocks);
+    const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
+    const auto* plane_cost = dynamic_cast<const sgraph::PlaneCost*>(cost);
+    if (plane_cost != nullptr && !is_free(scratch_blocks[0])) {
+      // A free plane seen by a held keyframe: the floor is seen from every keyframe, a long
+      // wall from hundreds. With the keyframe held the residual is linear in the plane,
+      // e = A [n; d] - b, so all such observations of a plane sum exactly into one quadratic;
+      // each is weighted by its Huber kernel at the current estimate (a reweighted step).
+      SumHeldObservation(*plane_cost, scratch_blocks,
+                         problem->GetLossFunctionForResidualBlock(id));
+      continue;
+    }
+    for (double* block : scratch_blocks) add_block(block);
+    window->AddResidualBlock(const_cast<ceres::CostFunction*>(cost),
+                             const_cast<ceres::LossFunction*>(
+                                 problem->GetLossFunctionForResidualBlock(id)),
+                             scratch_blocks.data(), static_cast<int>(scratch_blocks.size()));
+    ++kept;
+  }
+  for (const auto& [n, i] : window_free_planes) {
+    PlaneNode& p = planes[i];
+    if (p.held_observations == 0) continue;
+    auto prior = sgraph::QuadraticPrior::FromNormalEquations(p.held_H, p.held_g);
+    if (!prior) continue;  // nothing informative (never: an observation fixes d)
+    add_block(p.n);
+    add_block(p.d);
+    window->AddResidualBlock(prior.get(), nullptr, p.n, p.d);
+    window_costs.push_back(std::move(prior));
+    ++kept;
+  }
+  window_residual_count = kept;  // what Ceres is handed
+}
+
+void SGraph::Impl::SumHeldObservation(const sgraph::PlaneCost& cost,
+                                      const std::vector<double*>& blocks,
+                                      const ceres::LossFunction* loss) {
+  const sgraph::PlaneResidual& z = cost.functor();
+  const double* q = blocks[0];
+  const double* t = blocks[1];
+  const Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+  Eigen::Matrix<double, 3, 4> A = Eigen::Matrix<double, 3, 4>::Zero();
+  A.block<1, 3>(0, 0) = (R * z.basis_u).transpose();
+  A.block<1, 3>(1, 0) = (R * z.basis_v).transpose();
+  A.block<1, 3>(2, 0) = Eigen::Vector3d(t[0], t[1], t[2]).transpose();
+  A(2, 3) = 1.0;
+  const Eigen::Vector3d b(0, 0, z.d_measured);
+  const Eigen::Matrix<double, 3, 4> SA = z.sqrt_information * A;
+  const Eigen::Vector3d Sb = z.sqrt_information * b;
+  double weight = 1.0;
+  if (loss != nullptr) {
+    const Eigen::Vector4d x(blocks[2][0], blocks[2][1], blocks[2][2], blocks[3][0]);
+    double rho[3];
+    loss->Evaluate((SA * x - Sb).squaredNorm(), rho);
+    weight = rho[1];
+  }
+  // Which plane: blocks[2] is its normal block.
+  const auto at = std::lower_bound(
+      window_free_planes.begin(), window_free_planes.end(), blocks[2],
+      [](const std::pair<const double*, std::uint32_t>& e, const double* n) { return e.first < n; });
+  if (at == window_free_planes.end() || at->first != blocks[2]) return;  // never: it is free
+  PlaneNode& p = planes[at->second];
+  p.held_H += weight * SA.transpose() * SA;
+  p.held_g += weight * SA.transpose() * Sb;
+  ++p.held_observations;
+}
+
+void SGraph::Impl::WindowSnapshot(bool restore) {
+  std::size_t i = 0;
+  for (double* block : window_free) {
+    const int size = problem->ParameterBlockSize(block);
+    for (int k = 0; k < size && i < snapshot.size(); ++k, ++i) {
+      if (restore)
+        block[k] = snapshot[i];
+      else
+        snapshot[i] = block[k];
+    }
+  }
+}
+
+bool SGraph::Impl::WindowFinite() const {
+  for (const double* block : window_free) {
+    const int size = problem->ParameterBlockSize(block);
+    for (int k = 0; k < size; ++k)
+      if (!std::isfinite(block[k])) return false;
+  }
+  return true;
+}
+
+Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
+  Impl& m = *impl_;
+  ++m.stats.revision;  // every call that may change the graph
+  SGraphSolveReport report;
+  report.kind = kind;
+  if (m.active_factors == 0) {
+    report.usable = report.converged = true;  // nothing to solve
+    return report;
+  }
+  ceres::Problem* problem = m.problem.get();
+  if (kind == SolveKind::kLocal) {
+    report.free_keyframes = m.CollectWindow();
+    m.BuildWindowProblem();
+    problem = m.window.get();
+    m.stats.window_residuals_peak = std::max(m.stats.window_residuals_peak,
+                                             m.window_residual_count);
+  } else {
+    report.free_keyframes = m.active_keyframes > 0 ? m.active_keyframes - 1 : 0;
+  }
+  // Undo state: a local solve changes only its free blocks, so only those are kept (a full copy
+  // would cost in proportion to the graph again).
+  const bool local = kind == SolveKind::kLocal;
+  if (local) {
+    m.WindowSnapshot(false);
+  } else {
+    m.Snapshot(false);
+  }
+  ceres::Solver::Summary summary;
+  if (problem->NumResidualBlocks() > 0) {
+    ceres::Solve(SolverOptions(m.config, kind), problem, &summary);
+  } else {
+    summary.termination_type = ceres::CONVERGENCE;  // nothing in the window moves
+  }
+  m.window.reset();
+  ++m.stats.solves;
+  report.iterations = static_cast<int>(summary.iterations.size());
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.seconds = summary.total_time_in_seconds;
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
+  report.usable = (summary.termination_type == ceres::CONVERGENCE ||
+                   summary.termination_type == ceres::NO_CONVERGENCE ||
+                   summary.termination_type == ceres::USER_SUCCESS) &&
+                  std::isfinite(summary.final_cost) &&
+                  (local ? m.WindowFinite() : m.StateFinite());
+  if (!report.converged) ++m.stats.solves_not_converged;
+  if (!report.usable) {
+    // A failed solve leaves the graph as it was.
+    if (local) {
+      m.WindowSnapshot(true);
+    } else {
+      m.Snapshot(true);
+    }
+    ++m.stats.solves_undone;
+  }
+  return report;
+}
+
+}  // namespace msgraphs::core
