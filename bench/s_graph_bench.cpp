@@ -16,6 +16,7 @@
 
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 
 namespace {
 
@@ -178,6 +179,54 @@ void BM_SGraphFullSolve(benchmark::State& state) {
   TimeEachIteration(state, [&] { benchmark::DoNotOptimize(b.graph.Solve(SolveKind::kFull)); });
 }
 BENCHMARK(BM_SGraphFullSolve)
+    ->Arg(300)
+    ->Arg(500)
+    ->Arg(2000)
+    ->Arg(4000)
+    ->Iterations(10)->Unit(benchmark::kMillisecond);
+
+// The SLAM thread's share of a full solve in the background (SGraphSolveJob): copying the
+// graph into the job (begin) and putting the solution back (apply); the solve itself (run) is
+// another thread's, timed here for comparison with BM_SGraphFullSolve.
+void BM_SGraphBackgroundSolve(benchmark::State& state) {
+  const auto keyframes = static_cast<std::size_t>(state.range(0));
+  Building b(keyframes);
+  for (std::size_t i = 0; i < keyframes; ++i) b.AddKeyframe();
+  SGraphSolveJob job;
+  if (!job.Init(b.graph.config())) {
+    state.SkipWithError("job init");
+    return;
+  }
+  std::vector<double> begin_ms, run_ms, apply_ms;
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  };
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    if (!b.graph.BeginFullSolve(job)) {
+      state.SkipWithError("begin");
+      return;
+    }
+    begin_ms.push_back(since(t0));
+    t0 = Clock::now();
+    job.Complete();
+    run_ms.push_back(since(t0));
+    t0 = Clock::now();
+    benchmark::DoNotOptimize(b.graph.ApplyFullSolve(job));
+    apply_ms.push_back(since(t0));
+  }
+  const auto percentile = [](std::vector<double>& v, double q) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
+  };
+  state.counters["begin_p50_ms"] = percentile(begin_ms, 0.5);
+  state.counters["begin_p99_ms"] = percentile(begin_ms, 0.99);
+  state.counters["apply_p50_ms"] = percentile(apply_ms, 0.5);
+  state.counters["apply_p99_ms"] = percentile(apply_ms, 0.99);
+  state.counters["run_p50_ms"] = percentile(run_ms, 0.5);
+}
+BENCHMARK(BM_SGraphBackgroundSolve)
     ->Arg(300)
     ->Arg(500)
     ->Arg(2000)

@@ -11,6 +11,8 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "alloc_counter.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
@@ -667,6 +669,67 @@ TEST(LocalMapper, PatrolWithLoopsEverywhereStaysWithinTheGraphsCapacity) {
       "loops %llu, loop victims %zu, carried %zu, merged %zu; worst %.3f m (odometry %.3f)\n",
       static_cast<unsigned long long>(mapper.stats().loop_closures), s.sparsified_with_loops,
       s.sparsify_carried, s.sparsify_merged, worst, worst_odometry);
+}
+
+// Three laps of the room with loop closures every few keyframes, the full solve run on the spot
+// and in the background (full_solve_lag_keyframes, a worker thread running each job as the
+// node's does): the same map, within rounding of the local solves' time limits.
+struct PatrolResult {
+  std::vector<Eigen::Vector3d> positions;
+  double worst_m = 0;
+  LocalMapperStats stats;
+};
+
+PatrolResult Patrol(std::size_t lag, bool worker) {
+  LocalMapperConfig config = SmallConfig(64, 256);
+  config.full_solve_lag_keyframes = lag;
+  LocalMapper mapper;
+  EXPECT_TRUE(mapper.Init(config));
+  const Walk walk(45);
+  std::vector<float> times(20000, 0.1f);
+  std::jthread runner;
+  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
+    const double t = 10.0 + static_cast<double>(i);
+    EXPECT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
+    EXPECT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
+    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
+    EXPECT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
+    if (SGraphSolveJob* job = mapper.background_solve(); job != nullptr && worker) {
+      if (runner.joinable()) runner.join();
+      runner = std::jthread([job] {
+        if (job->TryClaim()) job->Run();
+      });
+    }
+  }
+  if (runner.joinable()) runner.join();
+  EXPECT_TRUE(mapper.Finish());
+  PatrolResult result;
+  const SGraph& g = mapper.graph();
+  for (std::uint32_t k = 0; k < g.keyframe_slots(); ++k) {
+    const auto i = static_cast<std::size_t>(g.keyframe_stamp(k) - 10.0 + 0.5);
+    result.positions.push_back(g.keyframe_pose(k).translation());
+    result.worst_m = std::max(result.worst_m,
+                              (g.keyframe_pose(k).translation() - walk.truth[i].translation()).norm());
+  }
+  result.stats = mapper.stats();
+  return result;
+}
+
+TEST(LocalMapper, TheFullSolveInTheBackgroundMakesTheSameMap) {
+  const PatrolResult on_the_spot = Patrol(0, false);
+  const PatrolResult background = Patrol(5, true);
+  const PatrolResult no_worker = Patrol(5, false);  // the mapper runs each job at its keyframe
+  EXPECT_LT(on_the_spot.worst_m, 0.05);
+  EXPECT_LT(background.worst_m, 0.05);
+  EXPECT_GE(background.stats.loop_closures, 3u);
+  EXPECT_GT(background.stats.full_solves_background, 0u);
+  EXPECT_EQ(on_the_spot.stats.full_solves_background, 0u);
+  EXPECT_EQ(no_worker.stats.full_solves_waited, no_worker.stats.full_solves_background);
+  ASSERT_EQ(background.positions.size(), no_worker.positions.size());
+  for (std::size_t k = 0; k < background.positions.size(); ++k) {
+    EXPECT_LT((background.positions[k] - no_worker.positions[k]).norm(), 1e-6) << k;
+    EXPECT_LT((background.positions[k] - on_the_spot.positions[k]).norm(), 0.02) << k;
+  }
 }
 
 TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {

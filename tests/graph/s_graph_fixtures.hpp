@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -121,5 +122,72 @@ inline double MaxPositionError(const SGraph& g,
   }
   return worst;
 }
+
+// A row of 6 m rooms along x, each with its own four walls and a room node, walked one way at
+// 0.6 m a keyframe with odometry 2 % long (10 keyframes a room).
+struct RoomRow {
+  SGraph graph;
+  std::mt19937 rng{11};
+  std::vector<std::uint32_t> ids;
+  std::vector<Eigen::Isometry3d> truth;
+  std::vector<std::array<std::int32_t, 4>> walls;
+  std::uint32_t floor = 0;
+
+  explicit RoomRow(const SGraphConfig& config) { EXPECT_TRUE(graph.Init(config)); }
+
+  static Eigen::Isometry3d TruePose(std::size_t k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = RotZ(0.05 * std::sin(0.4 * static_cast<double>(k)));
+    T.translation() << 0.3 + 0.6 * static_cast<double>(k), 0.5 * std::sin(0.3 * static_cast<double>(k)), 0;
+    return T;
+  }
+
+  std::array<TruePlane, 4> RoomWalls(std::size_t room) const {
+    const double x0 = 6.0 * static_cast<double>(room);
+    return {TruePlane{Eigen::Vector3d::UnitX(), -x0}, TruePlane{-Eigen::Vector3d::UnitX(), x0 + 6},
+            TruePlane{Eigen::Vector3d::UnitY(), 2.5}, TruePlane{-Eigen::Vector3d::UnitY(), 2.5}};
+  }
+
+  void Step() {
+    const std::size_t k = ids.size();
+    const Eigen::Isometry3d T = TruePose(k);
+    truth.push_back(T);
+    Eigen::Isometry3d delta = k == 0 ? T : TruePose(k - 1).inverse() * T;
+    delta.translation() *= 1.02;  // drifting odometry
+    const Eigen::Isometry3d guess = k == 0 ? T : graph.keyframe_pose(ids.back()) * delta;
+    const std::uint32_t id = *graph.AddKeyframe(static_cast<double>(k), guess);
+    if (k == 0) floor = *graph.AddPlane(Eigen::Vector3d::UnitZ(), 0.5, PlaneClass::kFloor);
+    if (k > 0) {
+      ASSERT_TRUE(graph.AddRelativePose(ids.back(), id, delta, OdometryInformation(),
+                                        RelativePoseKind::kOdometry));
+    }
+    ids.push_back(id);
+    const std::size_t room = static_cast<std::size_t>(T.translation().x() / 6.0);
+    const auto truth_walls = RoomWalls(room);
+    std::array<PlaneMeasurement, 4> z;
+    for (std::size_t i = 0; i < 4; ++i) z[i] = Measure(truth_walls[i], T, rng, 0.005);
+    if (walls.size() <= room) {
+      // A new room's walls start where the keyframe's estimate puts them, as the mapper does.
+      const Eigen::Isometry3d T_est = graph.keyframe_pose(id);
+      std::array<std::int32_t, 4> w{};
+      for (std::size_t i = 0; i < 4; ++i) {
+        const Eigen::Vector3d n = T_est.linear() * z[i].normal;
+        w[i] = static_cast<std::int32_t>(
+            *graph.AddPlane(n, z[i].d - n.dot(T_est.translation()), PlaneClass::kWall));
+      }
+      walls.push_back(w);
+    }
+    for (std::size_t i = 0; i < 4; ++i)
+      ASSERT_TRUE(graph.AddPlaneObservation(id, static_cast<std::uint32_t>(walls[room][i]), z[i]));
+    ASSERT_TRUE(graph.AddPlaneObservation(
+        id, floor, Measure(TruePlane{Eigen::Vector3d::UnitZ(), 0.5}, T, rng, 0.005)));
+    if (k % 10 == 5) {  // the room is found half way through it
+      MapRoom r;
+      r.centre = Eigen::Vector2d(6.0 * static_cast<double>(room) + 3, 0);
+      r.walls = walls[room];
+      ASSERT_TRUE(graph.AddRoom(r));
+    }
+  }
+};
 
 }  // namespace msgraphs::core::sgraph_test

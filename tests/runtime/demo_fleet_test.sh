@@ -32,6 +32,10 @@ for k in 1 2; do
   awk '!/^#/ { if (NF != 8) bad = 1; q = $5*$5 + $6*$6 + $7*$7 + $8*$8; if (q < 0.999 || q > 1.001) bad = 1; n++ }
        END { exit !(n >= 50 && !bad) }' "$out/robot$k.tum" || { echo "robot$k.tum malformed"; rc=1; }
 done
+# The full solve ran off the SLAM thread: applied from the background, run by the solver thread.
+awk '$1 == "full_solves_background" { b = $2 } $1 == "solver_thread_runs" { r = $2 }
+     END { printf "full solves: %d applied from the background, %d run by the solver thread\n", b, r; exit !(b > 0 && r > 0) }' \
+  "$out/nodes/robot1/stats.txt" || { echo "no full solve ran on the solver thread"; rc=1; }
 # g2o: every edge names vertices defined above it, the fixed vertex exists.
 awk '/^VERTEX_/ { v[$2] = 1; vertices++ }
      /^EDGE_SE3:QUAT|^EDGE_SE3_TRACKXYZ|^EDGE_POINTXYZ/ { edges++; if (!($2 in v) || !($3 in v)) bad = 1 }

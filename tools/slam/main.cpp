@@ -28,6 +28,7 @@
 #include <map>
 #include <numbers>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "msgraphs/core/slam/local_mapper.hpp"
@@ -128,6 +129,7 @@ int main(int argc, char** argv) {
   int robot = 1;
   bool markdown = false, verbose = false, odometry_from_truth = false;
   std::size_t max_keyframes = 0;
+  long full_solve_lag = -1;
   std::string matches_path;
   double fitness_floor_m2 = -1, fitness_outlier_z = -1;
   for (int i = 1; i < argc; ++i) {
@@ -140,6 +142,8 @@ int main(int argc, char** argv) {
       out_dir = argv[++i];
     else if (a == "--max-keyframes" && i + 1 < argc)
       max_keyframes = static_cast<std::size_t>(std::atol(argv[++i]));
+    else if (a == "--full-solve-lag" && i + 1 < argc)
+      full_solve_lag = std::atol(argv[++i]);
     else if (a == "--matches" && i + 1 < argc)
       matches_path = argv[++i];
     else if (a == "--fitness-floor" && i + 1 < argc)
@@ -155,7 +159,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] "
-                   "[--max-keyframes N] [--matches FILE] [--fitness-floor M2] "
+                   "[--max-keyframes N] [--full-solve-lag N] [--matches FILE] [--fitness-floor M2] "
                    "[--fitness-outlier-z Z] [--odometry-from-truth]\n");
       return 2;
     }
@@ -167,6 +171,7 @@ int main(int argc, char** argv) {
   }
   core::LocalMapperConfig config;
   if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;
+  if (full_solve_lag >= 0) config.full_solve_lag_keyframes = static_cast<std::size_t>(full_solve_lag);
   if (fitness_floor_m2 >= 0) config.scan_match_max_fitness_m2 = fitness_floor_m2;
   if (fitness_outlier_z >= 0) config.scan_match_fitness_outlier_z = fitness_outlier_z;
   std::vector<tools::StampedPose> truth_as_odometry;
@@ -196,6 +201,7 @@ int main(int argc, char** argv) {
   if (fs::exists(fs::path(run) / "world.world"))
     world = sim::LoadWorld((fs::path(run) / "world.world").string(), world_error);
   core::LocalMapper mapper;
+  std::jthread solver;  // the background full solve's runner (joined before the mapper goes)
   if (auto s = mapper.Init(config); !s) {
     std::fprintf(stderr, "slam: %s\n", s.error().detail);
     return 1;
@@ -254,6 +260,14 @@ int main(int argc, char** argv) {
     const auto outcome = mapper.AddScan(view, &timer);
     if (outcome && *outcome == core::ScanOutcome::kNotKeyframe)
       timer.Sweep(std::chrono::duration<double, std::milli>(Clock::now() - sweep_start).count());
+    // A full solve begun at this keyframe runs on its own thread, as in the node; the map does
+    // not depend on it (the mapper applies it at a fixed keyframe, running it there if need be).
+    if (core::SGraphSolveJob* job = mapper.background_solve()) {
+      if (solver.joinable()) solver.join();
+      solver = std::jthread([job] {
+        if (job->TryClaim()) job->Run();
+      });
+    }
     const core::ScanMatchRecord& m = mapper.last_scan_match();
     if (matches != nullptr && outcome && *outcome == core::ScanOutcome::kKeyframe && m.attempted) {
       const Eigen::Quaterniond q(m.T_from_to.linear());
@@ -271,6 +285,7 @@ int main(int argc, char** argv) {
                                                     : "");
     }
   }
+  if (solver.joinable()) solver.join();
   static_cast<void>(mapper.Finish());
   if (matches != nullptr && std::fclose(matches) != 0) {
     std::fprintf(stderr, "slam: writing %s failed\n", matches_path.c_str());
@@ -432,6 +447,15 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(gs.solves),
       static_cast<unsigned long long>(gs.solves_not_converged),
       static_cast<unsigned long long>(gs.solves_undone));
+  std::printf(
+      "full solves: %llu (lag %zu keyframes: %llu applied in the background, %llu waited for at "
+      "their keyframe, %llu unusable); loop closures %llu (%llu unchecked)\n",
+      static_cast<unsigned long long>(ms.full_solves), config.full_solve_lag_keyframes,
+      static_cast<unsigned long long>(ms.full_solves_background),
+      static_cast<unsigned long long>(ms.full_solves_waited),
+      static_cast<unsigned long long>(gs.background_unusable),
+      static_cast<unsigned long long>(ms.loop_closures),
+      static_cast<unsigned long long>(ms.loops_unchecked));
   std::printf(
       "scan matching: %llu accepted; rejected fitness %llu, overlap %llu, diverged %llu, failed "
       "%llu; %llu accepted above the fitness floor (limit now %.4f m^2); odometry gaps at %llu "

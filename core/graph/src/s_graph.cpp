@@ -47,10 +47,14 @@ Status SGraph::Init(const SGraphConfig& config) {
   Impl& m = *impl_;
   m.config = config;
   ceres::Problem::Options options;
-  options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  // The graph owns the costs (RetireCost): a background solve may still be evaluating one the
+  // graph removes.
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.enable_fast_removal = true;  // sparsification and room updates remove blocks
+  m.DeleteCosts();  // a second Init
+  m.jobs_borrowing = 0;
   m.problem = std::make_unique<ceres::Problem>(options);
   m.huber_relative = std::make_unique<ceres::HuberLoss>(config.huber_relative_pose);
   m.huber_loop = std::make_unique<ceres::HuberLoss>(config.huber_loop_closure);
@@ -72,6 +76,8 @@ Status SGraph::Init(const SGraphConfig& config) {
   m.free_factor_slots.clear();
   m.free_factor_slots.reserve(config.max_factors);
   m.factor_high_water = m.active_factors = 0;
+  m.retired_costs.reserve(config.max_factors);
+  m.scratch_costs.reserve(1024);  // the residual blocks on one node (RemoveBlock)
   m.snapshot.assign(
       (config.max_keyframes + 1) * 7 + config.max_planes * 4 + config.max_rooms * 2 + 2, 0.0);
   m.stats = SGraphStats{};
@@ -365,7 +371,7 @@ Status SGraph::RemoveRoom(std::uint32_t id) {
   if (r.factor != kNone) m.RemoveFactor(r.factor);
   if (r.floor_factor != kNone) m.RemoveFactor(r.floor_factor);
   r.factor = r.floor_factor = kNone;
-  if (r.in_problem) m.problem->RemoveParameterBlock(r.c);
+  if (r.in_problem) m.RemoveBlock(r.c);
   r.in_problem = false;
   r.info.active = false;
   return Ok();

@@ -111,6 +111,16 @@ inline Eigen::Isometry3d Fuse(const Eigen::Isometry3d& Z_a,
   return step.allFinite() ? Eigen::Isometry3d(Z_a * Se3Exp(step)) : Z_a;
 }
 
+// The solver's options for either solve (s_graph_solve.cpp).
+ceres::Solver::Options SolverOptions(const SGraphConfig& config, SolveKind kind);
+// The solver stopped with a state worth keeping (converged, or at its limits, with a finite cost).
+inline bool SolverFinished(const ceres::Solver::Summary& summary) {
+  return (summary.termination_type == ceres::CONVERGENCE ||
+          summary.termination_type == ceres::NO_CONVERGENCE ||
+          summary.termination_type == ceres::USER_SUCCESS) &&
+         std::isfinite(summary.final_cost);
+}
+
 // How every relative factor is built: sparsification reads a measurement back from its functor.
 using RelativePoseCost = ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>;
 // How every keyframe-to-plane factor is built: the local solve reads its measurement back.
@@ -126,6 +136,7 @@ using sgraph::PlaneNode;
 using sgraph::RoomNode;
 
 struct SGraph::Impl {
+  ~Impl() { DeleteCosts(); }
   SGraphConfig config;
   std::unique_ptr<ceres::Problem> problem;
   ceres::EigenQuaternionManifold quaternion_manifold;
@@ -150,6 +161,10 @@ struct SGraph::Impl {
   std::size_t factor_high_water = 0, active_factors = 0;
 
   std::vector<double> snapshot;  // parameter values before a solve, to undo a bad one
+  // Background full solve (s_graph_background.cpp): a job pending on this graph borrows its
+  // cost functions; removed ones wait in retired_costs until it is applied or dropped.
+  std::size_t jobs_borrowing = 0;
+  std::vector<const ceres::CostFunction*> retired_costs, scratch_costs;
   SGraphStats stats;
 
   // The local solve's window problem (s_graph_solve.cpp): built per local solve from the
@@ -245,8 +260,50 @@ struct SGraph::Impl {
   void RemoveFactor(std::int32_t slot) {
     FactorRecord& f = factors[static_cast<std::size_t>(slot)];
     if (!f.active) return;
-    problem->RemoveResidualBlock(f.id);
+    RemoveResidual(f.id);
     DropFactor(slot);
+  }
+
+  // The graph owns its cost functions, not the problem: a background solve (SGraphSolveJob)
+  // evaluates them on another thread, so one removed while a job borrows them is kept until the
+  // job is applied or dropped (ReleaseRetiredCosts), never deleted under it.
+  void RetireCost(const ceres::CostFunction* cost) {
+    if (jobs_borrowing > 0)
+      retired_costs.push_back(cost);  // capacity reserved at Init (a removal per factor slot)
+    else
+      delete cost;
+  }
+  void ReleaseRetiredCosts() {
+    for (const ceres::CostFunction* cost : retired_costs) delete cost;
+    retired_costs.clear();
+  }
+  void RemoveResidual(ceres::ResidualBlockId id) {
+    const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
+    problem->RemoveResidualBlock(id);
+    RetireCost(cost);
+  }
+  // Removes a parameter block and with it every residual block on it (and their costs).
+  void RemoveBlock(double* block) {
+    problem->GetResidualBlocksForParameterBlock(block, &scratch_residuals);
+    scratch_costs.clear();
+    for (ceres::ResidualBlockId id : scratch_residuals)
+      scratch_costs.push_back(problem->GetCostFunctionForResidualBlock(id));
+    problem->RemoveParameterBlock(block);
+    for (const ceres::CostFunction* cost : scratch_costs) RetireCost(cost);
+  }
+  // Every cost function the graph owns, at its end.
+  void DeleteCosts() {
+    window.reset();  // borrows them
+    if (problem) {
+      std::vector<ceres::ResidualBlockId> all;
+      problem->GetResidualBlocks(&all);
+      scratch_costs.clear();
+      for (ceres::ResidualBlockId id : all)
+        scratch_costs.push_back(problem->GetCostFunctionForResidualBlock(id));
+      problem.reset();
+      for (const ceres::CostFunction* cost : scratch_costs) delete cost;
+    }
+    ReleaseRetiredCosts();
   }
 
   void EnsurePlaneInProblem(PlaneNode& p) {

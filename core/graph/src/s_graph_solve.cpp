@@ -24,9 +24,8 @@
 #include "s_graph_quadratic_prior.hpp"
 
 namespace msgraphs::core {
-namespace {
 
-ceres::Solver::Options SolverOptions(const SGraphConfig& config, SolveKind kind) {
+ceres::Solver::Options sgraph::SolverOptions(const SGraphConfig& config, SolveKind kind) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -39,8 +38,6 @@ ceres::Solver::Options SolverOptions(const SGraphConfig& config, SolveKind kind)
   options.logging_type = ceres::SILENT;
   return options;
 }
-
-}  // namespace
 
 std::size_t SGraph::Impl::CollectWindow() {
   window_free.clear();
@@ -239,7 +236,7 @@ Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
   }
   ceres::Solver::Summary summary;
   if (problem->NumResidualBlocks() > 0) {
-    ceres::Solve(SolverOptions(m.config, kind), problem, &summary);
+    ceres::Solve(sgraph::SolverOptions(m.config, kind), problem, &summary);
   } else {
     summary.termination_type = ceres::CONVERGENCE;  // nothing in the window moves
   }
@@ -250,11 +247,8 @@ Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
   report.final_cost = summary.final_cost;
   report.seconds = summary.total_time_in_seconds;
   report.converged = summary.termination_type == ceres::CONVERGENCE;
-  report.usable = (summary.termination_type == ceres::CONVERGENCE ||
-                   summary.termination_type == ceres::NO_CONVERGENCE ||
-                   summary.termination_type == ceres::USER_SUCCESS) &&
-                  std::isfinite(summary.final_cost) &&
-                  (local ? m.WindowFinite() : m.StateFinite());
+  report.usable =
+      sgraph::SolverFinished(summary) && (local ? m.WindowFinite() : m.StateFinite());
   if (!report.converged) ++m.stats.solves_not_converged;
   if (!report.usable) {
     // A failed solve leaves the graph as it was.

@@ -227,8 +227,8 @@ bool SGraph::Impl::Sparsify() {
     }
   }
   KeyframeNode& node = keyframes[v];
-  problem->RemoveParameterBlock(node.q);
-  problem->RemoveParameterBlock(node.t);
+  RemoveBlock(node.q);
+  RemoveBlock(node.t);
   node.active = false;
   node.loop_factors = 0;
   keyframes[p].next = static_cast<std::int32_t>(n);

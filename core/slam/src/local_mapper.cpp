@@ -72,10 +72,20 @@ FitnessGateConfig LocalMapperConfig::scan_match_fitness_gate() const {
   return gate;
 }
 
+LocalMapper::~LocalMapper() {
+  if (full_job_.pending()) graph_.DropFullSolve(full_job_);  // waits for a worker running it
+}
+
 Status LocalMapper::Init(const LocalMapperConfig& config) {
   if (auto s = config.Validate(); !s) return s;
+  if (full_job_.pending()) graph_.DropFullSolve(full_job_);  // it borrows the graph's costs
   config_ = config;
   if (auto s = graph_.Init(config.graph); !s) return s;
+  if (auto s = full_job_.Init(config.graph); !s) return s;
+  pending_loops_.Init(kLoopChecks);
+  job_loops_.Init(kLoopChecks);
+  keyframe_count_ = full_apply_at_ = 0;
+  full_wanted_ = false;
   if (auto s = fitness_gate_.Init(config.scan_match_fitness_gate()); !s) return s;
   odometry_.Init(config.odometry_capacity, config.odometry_max_gap_s);
   const std::size_t slots = config.graph.max_keyframes + 1;
@@ -416,18 +426,7 @@ Expected<ScanOutcome> LocalMapper::AddScanImpl(const LidarScanView& scan, StageO
   const auto store = [this](std::uint32_t k, std::uint64_t s) { return clouds_.Get(k, s); };
   const bool loop = loops_.Detect(graph_, id, down_.span(), covariances_.span(), store);
   Stage(observer, MapperStage::kLoopClosure);
-  ++keyframes_since_full_;
-  if (loop || keyframes_since_full_ >= config_.full_solve_every_keyframes) {
-    static_cast<void>(graph_.Solve(SolveKind::kFull));
-    ++stats_.full_solves;
-    if (loop && loops_.RejectIfContradicted(graph_)) {
-      static_cast<void>(graph_.Solve(SolveKind::kFull));  // undo its pull
-      ++stats_.full_solves;
-    } else if (loop) {
-      ++stats_.loop_closures;
-    }
-    keyframes_since_full_ = 0;
-  }
+  ScheduleFullSolve(loop);
   Stage(observer, MapperStage::kFullSolve);
   if (++keyframes_since_rooms_ >= config_.room_update_every_keyframes) {
     keyframes_since_rooms_ = 0;
@@ -576,10 +575,24 @@ Status LocalMapper::SetPlanePriors(std::span<const PlanePrior> priors) {
 
 Status LocalMapper::Finish() {
   if (!have_keyframe_) return Ok();
+  if (full_job_.pending()) ApplyBackgroundSolve();
   static_cast<void>(rooms_.Update(grid_, planes_mapper_, graph_));
   auto report = graph_.Solve(SolveKind::kFull);
   if (!report) return report.error();
   ++stats_.full_solves;
+  // Loop closures no background solve has judged yet: this one does.
+  bool refused = false;
+  for (std::uint32_t f : pending_loops_) {
+    const bool out = loops_.RejectIfContradicted(graph_, f, nullptr);
+    refused = refused || out;
+    if (!out) ++stats_.loop_closures;
+  }
+  pending_loops_.clear();
+  if (refused) {
+    report = graph_.Solve(SolveKind::kFull);  // undo their pull
+    if (!report) return report.error();
+    ++stats_.full_solves;
+  }
   // The solve moved the keyframes the local map was built from.
   local_map_keyframe_ = local_map_failed_ = kNoKeyframe;
   T_map_odom_ = have_track_ ? graph_.keyframe_pose(last_keyframe_) * track_T_last_base_ * track_T_odom_.inverse()

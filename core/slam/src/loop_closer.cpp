@@ -159,9 +159,15 @@ bool LoopCloser::DetectImpl(SGraph& graph,
 namespace msgraphs::core {
 
 bool LoopCloser::RejectIfContradicted(SGraph& graph) {
-  const auto chi2 = graph.FactorChi2(stats_.last_factor);
+  return RejectIfContradicted(graph, stats_.last_factor, nullptr);
+}
+
+bool LoopCloser::RejectIfContradicted(SGraph& graph,
+                                      std::uint32_t factor,
+                                      const SGraphSolveJob* job) {
+  const auto chi2 = job != nullptr ? graph.FactorChi2(*job, factor) : graph.FactorChi2(factor);
   if (!chi2 || *chi2 <= config_.max_chi2_after_solve) return false;
-  if (!graph.RemoveFactor(stats_.last_factor)) return false;
+  if (!graph.RemoveFactor(factor)) return false;
   ++stats_.rejected_after_solve;
   --stats_.accepted;
   return true;

@@ -234,6 +234,9 @@ bool ParseNodeConfig(const std::string& text,
   r.Float("mapping", "max_range_m", 1.0, 120.0, c.mapper.max_range_m);
   r.Integer("mapping", "max_keyframes", 16, 1000000, c.mapper.graph.max_keyframes);
   r.Integer("mapping", "cloud_store_points", 100000, 100000000, c.mapper.cloud_store_points);
+  // The full solve on its own thread, applied this many keyframes after it began (0: on the
+  // SLAM thread; local_mapper.hpp, full_solve_lag_keyframes).
+  r.Integer("mapping", "full_solve_lag_keyframes", 0, 1000, c.mapper.full_solve_lag_keyframes);
   // The free-space grid: a square window, first centred on the start, that follows the robot
   // (grid_follows_robot), at its resolution (memory grows with the square of the extent:
   // 1024 x 1024 cells at the default).

@@ -28,6 +28,7 @@
 #include "msgraphs/runtime/pipeline/latency_window.hpp"
 #include "msgraphs/runtime/pipeline/node.hpp"
 #include "msgraphs/runtime/pipeline/replay_clock.hpp"
+#include "solver_worker.hpp"
 
 namespace msgraphs::runtime {
 
@@ -112,6 +113,7 @@ struct Node::Impl {
 
   // SLAM (owned by the SLAM thread once running).
   core::LocalMapper mapper;
+  SolverWorker solver;  ///< runs the mapper's full solve (its own thread)
   LatencyWindow keyframe_ms{4096};  ///< SLAM thread
   LatencyWindow wire_ms{4096};      ///< collab thread, under status_mutex
   std::vector<SteadyTime> unpublished_keyframes;  ///< last-packet times since the last Publish

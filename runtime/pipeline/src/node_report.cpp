@@ -193,6 +193,13 @@ void Node::Impl::PrintReport() {
           "p99, %.1f ms max\n",
           s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
           s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
+  // Read after the threads ended (the mapper is the SLAM thread's while it runs).
+  const core::LocalMapperStats& ms = mapper.stats();
+  Appendf(text,
+          "  full solves: %" PRIu64 " (lag %zu keyframes), %" PRIu64 " applied from the background, %" PRIu64
+          " run by the solver thread, %" PRIu64 " waited for at their keyframe; loop closures %" PRIu64 "\n",
+          ms.full_solves, config.mapper.full_solve_lag_keyframes, ms.full_solves_background,
+          solver.runs(), ms.full_solves_waited, ms.loop_closures);
   if (journal) {
     std::lock_guard<std::mutex> lock(journal_mutex);
     Appendf(text,
@@ -249,6 +256,10 @@ void Node::Impl::PrintReport() {
           "\nmatch_p50_ms %.2f\nmatch_p99_ms %.2f\nmatch_max_ms %.2f\n",
           s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
           s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
+  Appendf(stats,
+          "full_solves %" PRIu64 "\nfull_solves_background %" PRIu64 "\nsolver_thread_runs %" PRIu64
+          "\nfull_solves_waited %" PRIu64 "\n",
+          ms.full_solves, ms.full_solves_background, solver.runs(), ms.full_solves_waited);
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
   if (!config.output_dir.empty()) {

@@ -227,6 +227,7 @@ void Node::Impl::SlamLoop() {
     const double end_s = scan->end_s;
     if (outcome && *outcome == core::ScanOutcome::kKeyframe) {
       keyframe_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
+      solver.Offer(mapper.background_solve());  // a full solve begun at this keyframe
       // Only keyframes change the mapper's graph: only they are journaled, each with the motion
       // the sweeps before it tracked (replay makes the same keyframe from it).
       const core::LocalMapper::KeyframeMotion& motion = mapper.last_keyframe_motion();

@@ -67,6 +67,7 @@ struct SGraphConfig {
 enum class RelativePoseKind : std::uint8_t { kOdometry, kScanMatch, kLoopClosure, kSparsified };
 enum class PlaneClass : std::uint8_t { kWall, kFloor, kCeiling };
 enum class SolveKind : std::uint8_t { kLocal, kFull };
+class SGraphSolveJob;
 
 /// A plane measured in a keyframe's frame (n towards the sensor) with the covariance of the
 /// minimal perturbation (alpha, beta, delta_d) along basis_u and basis_v, as PlaneExtractor
@@ -154,6 +155,8 @@ struct SGraphStats {
   /// The most residual blocks a local solve's window problem held (its cost follows this, not
   /// the graph's size).
   std::size_t window_residuals_peak = 0;
+  /// Full solves run in the background (SGraphSolveJob): applied, and refused as unusable.
+  std::uint64_t background_applied = 0, background_unusable = 0;
   /// Goes up at every call that may change the graph (its structure or its estimates): equal
   /// revisions, the same graph (the distiller skips its work on it).
   std::uint64_t revision = 0;
@@ -225,6 +228,23 @@ class SGraph {
   Status AddFloorRoom(std::uint32_t room);
 
   Expected<SGraphSolveReport> Solve(SolveKind kind);
+
+  // ---- the full solve in the background (s_graph_solve_job.hpp) ----
+  /// Copies the graph as it is now into `job` (sized by its Init with this graph's config) for a
+  /// full solve elsewhere. kWouldBlock while another job is pending on this graph;
+  /// kInvalidArgument when the job was sized for a smaller graph. No allocation.
+  Status BeginFullSolve(SGraphSolveJob& job);
+  /// After job.Complete(): puts the solution back. Every node the job held takes the solution
+  /// plus what the graph did to it since the copy (local solves, a room re-centred); keyframes,
+  /// planes, rooms and the floor added since move rigidly with the newest keyframe the job held
+  /// that is still in the graph. An unusable solve (non-finite, failed) is not applied: the
+  /// report says so and the graph is as it was. Either way the job is finished.
+  Expected<SGraphSolveReport> ApplyFullSolve(SGraphSolveJob& job);
+  /// Finishes a job without applying it (after Complete, or before anybody claimed it).
+  void DropFullSolve(SGraphSolveJob& job);
+  /// FactorChi2 at the job's solution (done jobs only): how the solve that included the factor
+  /// judges it, before applying. kNotFound when the factor was not in the job or was removed.
+  Expected<double> FactorChi2(const SGraphSolveJob& job, std::uint32_t factor) const;
 
   // ---- state ----
   std::size_t keyframe_slots() const;  ///< ids handed out so far (active or sparsified)

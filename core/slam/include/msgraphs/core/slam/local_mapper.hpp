@@ -34,6 +34,7 @@
 #include "msgraphs/base/bounded_vector.hpp"
 #include "msgraphs/base/expected.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "msgraphs/core/perception/covariances.hpp"
 #include "msgraphs/core/perception/free_space_grid.hpp"
 #include "msgraphs/core/perception/kdtree.hpp"
@@ -123,6 +124,18 @@ struct LocalMapperConfig {
   double odometry_gate_chi2 = 22.46;
   std::size_t room_update_every_keyframes = 5;
   std::size_t full_solve_every_keyframes = 50;
+  /// Where the full solve runs (docs/s-graph.md, "The full solve in the background"). 0: on the
+  /// spot, on the mapper's thread; it grows with the graph (300 ms at 4,000 keyframes). N > 0:
+  /// it is begun at the keyframe that calls for it and applied N keyframes later; meanwhile
+  /// whoever claims it runs it (background_solve(): the node's solver thread), or the mapper
+  /// does at that keyframe if nobody did. The same keyframes make the same map either way. A
+  /// loop closure reaches the map N keyframes late, carried rigidly to the keyframes made
+  /// meanwhile, and is refused before it is applied if that solve contradicts it. The default
+  /// leaves the solve the time of 5 keyframes: a keyframe a metre or 20 degrees is about one a
+  /// second walking and one every 0.35 s turning on the spot (1 rad/s), so 1.75 s at least,
+  /// against 0.3 s for a full solve at 4,000 keyframes (docs/performance.md). A late one makes
+  /// the mapper wait at that keyframe (counted: full_solves_waited), never a different map.
+  std::size_t full_solve_lag_keyframes = 5;
   std::size_t max_plane_priors = 256;  ///< external wall priors held at once (SetPlanePriors)
   std::size_t cloud_store_points = 1500000;
   std::size_t odometry_capacity = 4096;
@@ -209,6 +222,12 @@ struct LocalMapperStats {
   std::uint64_t scans_tracked = 0, scans_untracked = 0;
   double scan_match_fitness_limit_m2 = 0;
   std::uint64_t loop_closures = 0, full_solves = 0;
+  /// Full solves in the background (full_solve_lag_keyframes > 0): applied; and of all begun,
+  /// those the mapper had to run itself or wait for at their keyframe (nobody ran them in time).
+  std::uint64_t full_solves_background = 0, full_solves_waited = 0;
+  /// Loop closures found while more than loop_checks_capacity waited for their solve: applied
+  /// without the contradiction check.
+  std::uint64_t loops_unchecked = 0;
   /// Keyframes the graph refused (its store full with nothing to sparsify, which a validated
   /// config rules out): the scan is skipped and the next one tries again.
   std::uint64_t keyframes_refused = 0;
@@ -256,6 +275,12 @@ struct Relocalisation {
 
 class LocalMapper {
  public:
+  LocalMapper() = default;
+  /// Waits for a background full solve a worker is running (it borrows the graph).
+  ~LocalMapper();
+  LocalMapper(const LocalMapper&) = delete;
+  LocalMapper& operator=(const LocalMapper&) = delete;
+
   Status Init(const LocalMapperConfig& config);
 
   /// Encoder odometry (base frame in the odometry frame), in time order.
@@ -294,8 +319,16 @@ class LocalMapper {
                                       const Eigen::Isometry3d& T_new_end,
                                       const RelocaliseSearch& search);
 
-  /// A full solve now (for example at the end of a mission).
+  /// A full solve now (for example at the end of a mission); a background one pending is
+  /// completed and applied first.
   Status Finish();
+
+  /// The background full solve when one is begun and nobody has run it yet, for a worker
+  /// thread to take (TryClaim, then Run); nullptr otherwise. The mapper must outlive the worker's
+  /// use of it. See full_solve_lag_keyframes.
+  SGraphSolveJob* background_solve() {
+    return full_job_.pending() && !full_job_.done() ? &full_job_ : nullptr;
+  }
 
   /// Replaces the external priors on this robot's walls (other robots' measurements of the same
   /// walls through the collaborative graph, CollabSession::PlanePriors). The next keyframe runs
@@ -366,6 +399,11 @@ class LocalMapper {
   /// odometry's step `delta` giving direction and rotation; false when there is none.
   bool MotionSeed(const Eigen::Isometry3d& delta, double end_s, Eigen::Isometry3d& seed) const;
   void ExtractPlanes(std::uint32_t keyframe);
+  /// The full solve's schedule at a keyframe (local_mapper_full_solve.cpp): on the spot, or
+  /// begun and applied full_solve_lag_keyframes later.
+  void ScheduleFullSolve(bool loop);
+  void ApplyBackgroundSolve();
+  void BeginBackgroundSolve();
 
   LocalMapperConfig config_;
   SGraph graph_;
@@ -423,6 +461,14 @@ class LocalMapper {
   // motion_end_s_.
   double motion_m_ = 0, motion_s_ = 0, motion_end_s_ = 0;
   std::size_t keyframes_since_rooms_ = 0, keyframes_since_full_ = 0;
+  // The background full solve: the job, the keyframe count at which it is applied, whether
+  // another is wanted, and the loop closures waiting for a solve to judge them (pending: since
+  // the job began; job_loops_: in it).
+  static constexpr std::size_t kLoopChecks = 16;
+  SGraphSolveJob full_job_;
+  std::uint64_t keyframe_count_ = 0, full_apply_at_ = 0;
+  bool full_wanted_ = false;
+  BoundedVector<std::uint32_t> pending_loops_, job_loops_;
   LocalMapperStats stats_;
 };
 

@@ -22,6 +22,7 @@
 #include "msgraphs/base/expected.hpp"
 #include "msgraphs/core/descriptors/scan_context.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "msgraphs/core/perception/kdtree.hpp"
 #include "msgraphs/core/registration/gaussian_voxel_map.hpp"
 #include "msgraphs/core/registration/vgicp.hpp"
@@ -99,6 +100,9 @@ class LoopCloser {
 
   /// Checks the newest loop against the solved graph; removes it (true) when contradicted.
   bool RejectIfContradicted(SGraph& graph);
+  /// Checks loop factor `factor` against the solved graph, or against a background full solve
+  /// that included it (`job`, before that solve is applied); removes it (true) when contradicted.
+  bool RejectIfContradicted(SGraph& graph, std::uint32_t factor, const SGraphSolveJob* job);
 
   const LoopClosureStats& stats() const { return stats_; }
 

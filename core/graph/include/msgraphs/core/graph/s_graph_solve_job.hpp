@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: MIT
+// A full solve of an S-Graph run away from it (docs/s-graph.md, "The full solve in the
+// background").
+//
+// A full solve costs in proportion to the graph (300 ms at 4,000 keyframes), too long for the
+// thread that takes a keyframe every few hundred milliseconds. So it is split in three:
+// - SGraph::BeginFullSolve (the graph's thread) copies every estimate and the list of residual
+//   blocks into the job: memory copies, no solving;
+// - Run (any thread) solves that copy while the graph goes on taking keyframes, local solves
+//   and removals. It touches only the job's memory and the graph's cost functions and losses,
+//   which never change once made; the graph keeps every one it removes while a job borrows them;
+// - SGraph::ApplyFullSolve (the graph's thread) puts the solution back, carrying what the
+//   graph did since: nodes in the job take the solution plus their own change since the copy,
+//   nodes added since move rigidly with the newest keyframe the job held.
+//
+// Who runs it: whoever claims it first. A worker thread calls TryClaim and then Run; the graph's
+// thread calls Complete at its apply point, which runs the job itself if nobody claimed it and
+// otherwise waits for the worker. The result is the same with or without a worker and whatever
+// its timing: the copy is taken at a fixed point and applied at a fixed point.
+//
+// Memory: Init sizes the copy from the graph's config (allocates); BeginFullSolve and
+// ApplyFullSolve do not allocate beyond that. Run allocates (it builds a Ceres problem): it is
+// the background path. The graph must outlive a job that borrows from it.
+#pragma once
+
+#include <memory>
+
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/core/graph/s_graph.hpp"
+
+namespace msgraphs::core {
+
+class SGraphSolveJob {
+ public:
+  SGraphSolveJob();
+  ~SGraphSolveJob();
+  SGraphSolveJob(const SGraphSolveJob&) = delete;
+  SGraphSolveJob& operator=(const SGraphSolveJob&) = delete;
+
+  /// Sizes the copy for graphs made with `config` (allocates).
+  Status Init(const SGraphConfig& config);
+
+  /// A begun job that nobody runs yet becomes this caller's: true, then call Run. False when
+  /// there is nothing to run or somebody else has it. Any thread.
+  bool TryClaim();
+  /// Solves the copy (after a successful TryClaim). Any thread; allocates.
+  void Run();
+  /// The graph's thread, before ApplyFullSolve: runs the job here if nobody claimed it, else
+  /// waits until its runner is done.
+  void Complete();
+
+  /// Begun and not yet applied or dropped.
+  bool pending() const;
+  /// Solved (Run has returned) and not yet applied or dropped.
+  bool done() const;
+  /// The solve's report, once done.
+  const SGraphSolveReport& report() const;
+
+ private:
+  friend class SGraph;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace msgraphs::core

@@ -1,0 +1,385 @@
+// SPDX-License-Identifier: MIT
+// The full solve in the background (s_graph_solve_job.hpp, docs/s-graph.md).
+//
+// The job holds two copies of every estimate: `begin` as the graph had it at BeginFullSolve,
+// and `solved`, which Run optimises in place. ApplyFullSolve uses the pair to carry what the
+// graph did in the meantime: a node the job held gets solved + (now - begin) (for a keyframe,
+// the correction T_solved T_begin^-1 applied on the left), and a node added since gets the
+// correction of the newest keyframe the job held, the one it was built on.
+#include <ceres/ceres.h>
+#include <ceres/sphere_manifold.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <type_traits>
+#include <vector>
+
+#include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
+#include "s_graph_impl.hpp"
+
+namespace msgraphs::core {
+namespace {
+
+enum JobState : int { kIdle, kReady, kRunning, kDone };
+
+// Every estimate of a graph, flat, by slot.
+struct Values {
+  std::vector<double> kq, kt, pn, pd, rc;
+  double floor[2] = {0, 0};
+
+  Eigen::Isometry3d Pose(std::size_t k) const {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::Quaterniond(kq[4 * k + 3], kq[4 * k], kq[4 * k + 1], kq[4 * k + 2])
+                     .normalized()
+                     .toRotationMatrix();
+    T.translation() = Eigen::Vector3d(kt[3 * k], kt[3 * k + 1], kt[3 * k + 2]);
+    return T;
+  }
+  bool Finite() const {
+    for (const auto* v : {&kq, &kt, &pn, &pd, &rc})
+      for (double x : *v)
+        if (!std::isfinite(x)) return false;
+    return std::isfinite(floor[0]) && std::isfinite(floor[1]);
+  }
+};
+
+struct JobResidual {
+  const ceres::CostFunction* cost = nullptr;
+  const ceres::LossFunction* loss = nullptr;
+  ceres::ResidualBlockId id = nullptr;  // in the graph's problem: FactorChi2 finds it by this
+  std::uint32_t first = 0, count = 0;   // its parameter blocks: refs[first, first + count)
+};
+
+void SetPose(KeyframeNode& k, const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.linear());
+  k.q[0] = q.x();
+  k.q[1] = q.y();
+  k.q[2] = q.z();
+  k.q[3] = q.w();
+  for (int i = 0; i < 3; ++i) k.t[i] = T.translation()[i];
+}
+
+}  // namespace
+
+struct SGraphSolveJob::Impl {
+  std::atomic<int> state{kIdle};
+  bool sized = false;
+  SGraphConfig config;
+  const void* graph = nullptr;  // the graph whose costs it borrows
+  Values begin, solved;
+  std::vector<double> stamp;  // keyframe slots are reused: a held keyframe has the same stamp
+  std::vector<std::uint8_t> keyframe_in, plane_in, room_in;
+  bool floor_in = false;
+  std::size_t keyframe_slots = 0, plane_count = 0, room_count = 0;
+  std::int32_t origin = kNone;
+  std::vector<JobResidual> residuals;
+  std::vector<double*> refs;  // into `solved`
+  std::vector<ceres::ResidualBlockId> ids;
+  ceres::EigenQuaternionManifold quaternion_manifold;
+  ceres::SphereManifold<3> sphere_manifold;
+  SGraphSolveReport report;
+
+  bool Held(std::size_t k, const KeyframeNode& now) const {
+    return k < keyframe_slots && keyframe_in[k] && stamp[k] == now.stamp_s;
+  }
+  Eigen::Isometry3d Correction(std::size_t k) const {
+    return solved.Pose(k) * begin.Pose(k).inverse();
+  }
+};
+
+SGraphSolveJob::SGraphSolveJob() : impl_(std::make_unique<Impl>()) {}
+SGraphSolveJob::~SGraphSolveJob() = default;
+
+Status SGraphSolveJob::Init(const SGraphConfig& config) {
+  if (auto s = config.Validate(); !s) return s;
+  Impl& j = *impl_;
+  if (j.state.load() != kIdle) return Error{Errc::kWouldBlock, "the job is pending"};
+  j.config = config;
+  const std::size_t keyframes = config.max_keyframes + 1, planes = config.max_planes,
+                    rooms = config.max_rooms;
+  for (Values* v : {&j.begin, &j.solved}) {
+    v->kq.assign(4 * keyframes, 0.0);
+    v->kt.assign(3 * keyframes, 0.0);
+    v->pn.assign(3 * planes, 0.0);
+    v->pd.assign(planes, 0.0);
+    v->rc.assign(2 * rooms, 0.0);
+  }
+  j.stamp.assign(keyframes, 0.0);
+  j.keyframe_in.assign(keyframes, 0);
+  j.plane_in.assign(planes, 0);
+  j.room_in.assign(rooms, 0);
+  // Every factor record is one residual block; a room's has the most parameter blocks (9).
+  j.residuals.reserve(config.max_factors);
+  j.ids.reserve(config.max_factors);
+  j.refs.reserve(config.max_factors * 4);
+  j.sized = true;
+  return Ok();
+}
+
+bool SGraphSolveJob::TryClaim() {
+  int expected = kReady;
+  return impl_->state.compare_exchange_strong(expected, kRunning, std::memory_order_acquire);
+}
+
+void SGraphSolveJob::Run() {
+  Impl& j = *impl_;
+  Values& x = j.solved;
+  ceres::Problem::Options options;
+  // Everything is borrowed: the graph's costs and losses, the job's manifolds and memory.
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(options);
+  for (std::size_t k = 0; k < j.keyframe_slots; ++k) {
+    if (!j.keyframe_in[k]) continue;
+    problem.AddParameterBlock(&x.kq[4 * k], 4, &j.quaternion_manifold);
+    problem.AddParameterBlock(&x.kt[3 * k], 3);
+    if (static_cast<std::int32_t>(k) == j.origin) {  // the gauge, as in the graph
+      problem.SetParameterBlockConstant(&x.kq[4 * k]);
+      problem.SetParameterBlockConstant(&x.kt[3 * k]);
+    }
+  }
+  for (std::size_t i = 0; i < j.plane_count; ++i) {
+    if (!j.plane_in[i]) continue;
+    problem.AddParameterBlock(&x.pn[3 * i], 3, &j.sphere_manifold);
+    problem.AddParameterBlock(&x.pd[i], 1);
+  }
+  for (std::size_t i = 0; i < j.room_count; ++i)
+    if (j.room_in[i]) problem.AddParameterBlock(&x.rc[2 * i], 2);
+  if (j.floor_in) problem.AddParameterBlock(x.floor, 2);
+  for (const JobResidual& r : j.residuals) {
+    problem.AddResidualBlock(const_cast<ceres::CostFunction*>(r.cost),
+                             const_cast<ceres::LossFunction*>(r.loss), j.refs.data() + r.first,
+                             static_cast<int>(r.count));
+  }
+  SGraphSolveReport report;
+  report.kind = SolveKind::kFull;
+  std::size_t keyframes = 0;
+  for (std::size_t k = 0; k < j.keyframe_slots; ++k) keyframes += j.keyframe_in[k];
+  report.free_keyframes = keyframes > 0 ? keyframes - 1 : 0;
+  if (problem.NumResidualBlocks() == 0) {
+    report.usable = report.converged = true;
+  } else {
+    ceres::Solver::Summary summary;
+    ceres::Solve(sgraph::SolverOptions(j.config, SolveKind::kFull), &problem, &summary);
+    report.iterations = static_cast<int>(summary.iterations.size());
+    report.initial_cost = summary.initial_cost;
+    report.final_cost = summary.final_cost;
+    report.seconds = summary.total_time_in_seconds;
+    report.converged = summary.termination_type == ceres::CONVERGENCE;
+    report.usable = sgraph::SolverFinished(summary) && x.Finite();
+  }
+  j.report = report;
+  j.state.store(kDone, std::memory_order_release);
+  j.state.notify_all();
+}
+
+void SGraphSolveJob::Complete() {
+  if (TryClaim()) {
+    Run();
+    return;
+  }
+  Impl& j = *impl_;
+  for (int s = j.state.load(std::memory_order_acquire); s == kRunning;
+       s = j.state.load(std::memory_order_acquire)) {
+    j.state.wait(kRunning, std::memory_order_acquire);
+  }
+}
+
+bool SGraphSolveJob::pending() const { return impl_->state.load() != kIdle; }
+bool SGraphSolveJob::done() const { return impl_->state.load() == kDone; }
+const SGraphSolveReport& SGraphSolveJob::report() const { return impl_->report; }
+
+Status SGraph::BeginFullSolve(SGraphSolveJob& job) {
+  Impl& m = *impl_;
+  SGraphSolveJob::Impl& j = *job.impl_;
+  if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
+  if (!j.sized || j.stamp.size() < m.keyframes.size() || j.plane_in.size() < m.planes.size() ||
+      j.room_in.size() < m.rooms.size()) {
+    return Error{Errc::kInvalidArgument, "solve job sized for a smaller graph"};
+  }
+  if (m.jobs_borrowing > 0 || j.state.load() != kIdle) {
+    return Error{Errc::kWouldBlock, "a background solve is pending"};
+  }
+  j.config = m.config;  // the graph's solver limits
+  Values& b = j.begin;
+  j.keyframe_slots = m.keyframe_high_water;
+  for (std::size_t k = 0; k < m.keyframe_high_water; ++k) {
+    const KeyframeNode& node = m.keyframes[k];
+    j.keyframe_in[k] = node.active;
+    j.stamp[k] = node.stamp_s;
+    std::copy(node.q, node.q + 4, &b.kq[4 * k]);
+    std::copy(node.t, node.t + 3, &b.kt[3 * k]);
+  }
+  j.origin = m.origin;
+  j.plane_count = m.plane_count;
+  for (std::size_t i = 0; i < m.plane_count; ++i) {
+    const PlaneNode& p = m.planes[i];
+    j.plane_in[i] = p.in_problem;
+    std::copy(p.n, p.n + 3, &b.pn[3 * i]);
+    b.pd[i] = p.d[0];
+  }
+  j.room_count = m.room_count;
+  for (std::size_t i = 0; i < m.room_count; ++i) {
+    j.room_in[i] = m.rooms[i].in_problem;
+    std::copy(m.rooms[i].c, m.rooms[i].c + 2, &b.rc[2 * i]);
+  }
+  j.floor_in = m.problem->HasParameterBlock(m.floor_c);
+  std::copy(m.floor_c, m.floor_c + 2, b.floor);
+  j.solved = b;  // same sizes: copies into the memory Init made
+  // The residual blocks, their parameter blocks mapped from the graph's memory to the copy's.
+  Values& x = j.solved;
+  const auto slot = [](const auto& store, const double* block) -> std::size_t {
+    using Node = typename std::decay_t<decltype(store)>::value_type;
+    const auto* base = reinterpret_cast<const unsigned char*>(store.data());
+    const auto* at = reinterpret_cast<const unsigned char*>(block);
+    if (at < base || at >= base + store.size() * sizeof(Node)) return store.size();
+    return static_cast<std::size_t>(at - base) / sizeof(Node);
+  };
+  const auto map = [&](const double* block) -> double* {
+    if (const std::size_t k = slot(m.keyframes, block); k < m.keyframes.size()) {
+      if (block == m.keyframes[k].q) return &x.kq[4 * k];
+      if (block == m.keyframes[k].t) return &x.kt[3 * k];
+    } else if (const std::size_t i = slot(m.planes, block); i < m.planes.size()) {
+      if (block == m.planes[i].n) return &x.pn[3 * i];
+      if (block == m.planes[i].d) return &x.pd[i];
+    } else if (const std::size_t r = slot(m.rooms, block); r < m.rooms.size()) {
+      if (block == m.rooms[r].c) return &x.rc[2 * r];
+    } else if (block == m.floor_c) {
+      return x.floor;
+    }
+    return nullptr;
+  };
+  m.problem->GetResidualBlocks(&j.ids);
+  j.residuals.clear();
+  j.refs.clear();
+  for (ceres::ResidualBlockId id : j.ids) {
+    JobResidual r;
+    r.cost = m.problem->GetCostFunctionForResidualBlock(id);
+    r.loss = m.problem->GetLossFunctionForResidualBlock(id);
+    r.id = id;
+    r.first = static_cast<std::uint32_t>(j.refs.size());
+    m.problem->GetParameterBlocksForResidualBlock(id, &m.scratch_blocks);
+    for (const double* block : m.scratch_blocks) {
+      double* mapped = map(block);
+      if (mapped == nullptr)
+        return Error{Errc::kInvalidArgument, "parameter block not in the graph"};
+      j.refs.push_back(mapped);
+    }
+    r.count = static_cast<std::uint32_t>(m.scratch_blocks.size());
+    j.residuals.push_back(r);
+  }
+  j.graph = this;
+  m.jobs_borrowing = 1;
+  j.state.store(kReady, std::memory_order_release);
+  return Ok();
+}
+
+Expected<double> SGraph::FactorChi2(const SGraphSolveJob& job, std::uint32_t factor) const {
+  const Impl& m = *impl_;
+  const SGraphSolveJob::Impl& j = *job.impl_;
+  if (j.graph != this || j.state.load(std::memory_order_acquire) != kDone)
+    return Error{Errc::kInvalidArgument, "solve job not done on this graph"};
+  if (factor >= m.factor_high_water || !m.factors[factor].active)
+    return Error{Errc::kNotFound, "no such factor"};
+  const ceres::ResidualBlockId id = m.factors[factor].id;
+  // Costs are never freed while the job borrows them, so the pair names one factor.
+  const ceres::CostFunction* cost = m.problem->GetCostFunctionForResidualBlock(id);
+  for (const JobResidual& r : j.residuals) {
+    if (r.id != id || r.cost != cost) continue;
+    std::array<double, 16> residual{};
+    if (cost->num_residuals() > static_cast<int>(residual.size()))
+      return Error{Errc::kInvalidArgument, "factor too large to evaluate"};
+    if (!cost->Evaluate(j.refs.data() + r.first, residual.data(), nullptr))
+      return Error{Errc::kDegenerate, "factor could not be evaluated"};
+    double chi2 = 0;
+    for (int i = 0; i < cost->num_residuals(); ++i)
+      chi2 += residual[static_cast<std::size_t>(i)] * residual[static_cast<std::size_t>(i)];
+    return chi2;
+  }
+  return Error{Errc::kNotFound, "factor not in the solve job"};
+}
+
+void SGraph::DropFullSolve(SGraphSolveJob& job) {
+  Impl& m = *impl_;
+  SGraphSolveJob::Impl& j = *job.impl_;
+  if (j.graph != this) return;
+  if (j.state.load() != kIdle && !job.TryClaim()) job.Complete();  // a runner has it: wait
+  j.state.store(kIdle, std::memory_order_release);
+  j.graph = nullptr;
+  m.jobs_borrowing = 0;
+  m.ReleaseRetiredCosts();
+}
+
+Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
+  Impl& m = *impl_;
+  SGraphSolveJob::Impl& j = *job.impl_;
+  if (j.graph != this || j.state.load(std::memory_order_acquire) != kDone)
+    return Error{Errc::kInvalidArgument, "solve job not done on this graph"};
+  const SGraphSolveReport report = j.report;
+  ++m.stats.solves;
+  if (!report.converged) ++m.stats.solves_not_converged;
+  if (!report.usable) {
+    ++m.stats.background_unusable;
+    DropFullSolve(job);
+    return report;
+  }
+  ++m.stats.revision;  // every call that may change the graph
+  // The newest keyframe the job held that is still here: what a newer node was built on.
+  std::int32_t anchor = m.newest;
+  while (anchor != kNone &&
+         !j.Held(static_cast<std::size_t>(anchor), m.keyframes[static_cast<std::size_t>(anchor)]))
+    anchor = m.keyframes[static_cast<std::size_t>(anchor)].prev;
+  const Eigen::Isometry3d C_anchor = anchor != kNone
+                                         ? j.Correction(static_cast<std::size_t>(anchor))
+                                         : Eigen::Isometry3d::Identity();
+  for (std::size_t k = 0; k < m.keyframe_high_water; ++k) {
+    KeyframeNode& node = m.keyframes[k];
+    if (!node.active) continue;
+    const Eigen::Isometry3d C = j.Held(k, node) ? j.Correction(k) : C_anchor;
+    SetPose(node, C * m.Pose(static_cast<std::uint32_t>(k)));
+  }
+  const Values& b = j.begin;
+  const Values& x = j.solved;
+  for (std::size_t i = 0; i < m.plane_count; ++i) {
+    PlaneNode& p = m.planes[i];
+    if (!p.in_problem) continue;
+    Eigen::Vector3d n(p.n[0], p.n[1], p.n[2]);
+    double d = p.d[0];
+    if (i < j.plane_count && j.plane_in[i]) {
+      n += Eigen::Vector3d(&x.pn[3 * i]) - Eigen::Vector3d(&b.pn[3 * i]);
+      d += x.pd[i] - b.pd[i];
+    } else {  // n.p + d = 0 carried by p' = C p
+      n = C_anchor.linear() * n;
+      d -= n.dot(C_anchor.translation());
+    }
+    n.normalize();
+    std::copy(n.data(), n.data() + 3, p.n);
+    p.d[0] = d;
+  }
+  const auto carry = [&](double* c, const double* c_begin, const double* c_solved, bool held) {
+    if (held) {
+      c[0] += c_solved[0] - c_begin[0];
+      c[1] += c_solved[1] - c_begin[1];
+      return;
+    }
+    const double z = anchor != kNone ? b.kt[3 * static_cast<std::size_t>(anchor) + 2] : 0.0;
+    const Eigen::Vector3d moved = C_anchor * Eigen::Vector3d(c[0], c[1], z);
+    c[0] = moved.x();
+    c[1] = moved.y();
+  };
+  for (std::size_t i = 0; i < m.room_count; ++i) {
+    RoomNode& r = m.rooms[i];
+    if (!r.in_problem) continue;
+    carry(r.c, &b.rc[2 * i], &x.rc[2 * i], i < j.room_count && j.room_in[i]);
+  }
+  if (m.problem->HasParameterBlock(m.floor_c)) carry(m.floor_c, b.floor, x.floor, j.floor_in);
+  ++m.stats.background_applied;
+  DropFullSolve(job);
+  return report;
+}
+
+}  // namespace msgraphs::core

@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+// When the mapper's full solve runs (LocalMapperConfig::full_solve_lag_keyframes, docs/s-graph.md).
+//
+// On the spot (lag 0): after a loop closure and every full_solve_every_keyframes keyframes, on
+// the mapper's thread, and the new loop judged by the solved graph (undone by a second solve
+// when contradicted).
+//
+// In the background (lag N): the same keyframes call for it, but the graph is copied into a
+// job (SGraph::BeginFullSolve) and the job applied N keyframes later. The schedule counts
+// keyframes, never time, so the same keyframes make the same map whoever runs the job and
+// whenever: a journal replay rebuilds the live map. A loop closure found meanwhile waits for the
+// next job; each is judged by the solve that included it before that solve is applied, and a
+// contradicted one is removed and the solve dropped (another begins at once without it), so
+// a false loop never pulls the map.
+#include "msgraphs/core/slam/local_mapper.hpp"
+
+namespace msgraphs::core {
+
+void LocalMapper::ScheduleFullSolve(bool loop) {
+  ++keyframe_count_;
+  ++keyframes_since_full_;
+  const bool due = loop || keyframes_since_full_ >= config_.full_solve_every_keyframes;
+  if (config_.full_solve_lag_keyframes == 0) {
+    if (!due) return;
+    static_cast<void>(graph_.Solve(SolveKind::kFull));
+    ++stats_.full_solves;
+    if (loop && loops_.RejectIfContradicted(graph_)) {
+      static_cast<void>(graph_.Solve(SolveKind::kFull));  // undo its pull
+      ++stats_.full_solves;
+    } else if (loop) {
+      ++stats_.loop_closures;
+    }
+    keyframes_since_full_ = 0;
+    return;
+  }
+  if (loop && !pending_loops_.try_push_back(loops_.stats().last_factor)) {
+    ++stats_.loops_unchecked;
+    ++stats_.loop_closures;
+  }
+  if (due) {
+    full_wanted_ = true;
+    keyframes_since_full_ = 0;
+  }
+  if (full_job_.pending() && keyframe_count_ >= full_apply_at_) ApplyBackgroundSolve();
+  if (full_wanted_ && !full_job_.pending()) BeginBackgroundSolve();
+}
+
+void LocalMapper::BeginBackgroundSolve() {
+  if (!graph_.BeginFullSolve(full_job_)) return;  // never: one job at a time, sized at Init
+  job_loops_.clear();
+  for (std::uint32_t f : pending_loops_) static_cast<void>(job_loops_.try_push_back(f));
+  pending_loops_.clear();
+  full_apply_at_ = keyframe_count_ + config_.full_solve_lag_keyframes;
+  full_wanted_ = false;
+}
+
+void LocalMapper::ApplyBackgroundSolve() {
+  if (!full_job_.done()) ++stats_.full_solves_waited;
+  full_job_.Complete();  // runs it here if nobody claimed it, else waits for its runner
+  ++stats_.full_solves;
+  bool refused = false;
+  for (std::uint32_t f : job_loops_)
+    refused = loops_.RejectIfContradicted(graph_, f, &full_job_) || refused;
+  if (refused) {
+    // The solve was pulled by a loop now removed: solve again without it, at once.
+    graph_.DropFullSolve(full_job_);
+    for (std::uint32_t f : job_loops_)
+      if (graph_.FactorChi2(f)) ++stats_.loop_closures;  // the others stand
+    full_wanted_ = true;
+  } else {
+    if (graph_.ApplyFullSolve(full_job_)) ++stats_.full_solves_background;
+    stats_.loop_closures += job_loops_.size();
+  }
+  job_loops_.clear();
+}
+
+}  // namespace msgraphs::core
