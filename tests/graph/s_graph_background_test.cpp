@@ -78,7 +78,7 @@ TEST(SGraphBackground, TheGraphGoesOnWhileAWorkerSolves) {
   ASSERT_TRUE(job.Init(config));
   ASSERT_TRUE(row.graph.BeginFullSolve(job));
   EXPECT_FALSE(row.graph.BeginFullSolve(job));  // one at a time
-  std::thread worker([&job] {
+  std::jthread worker([&job] {
     if (job.TryClaim()) job.Run();
   });
   // Meanwhile: 15 more keyframes (new walls, a new room), local solves, and the loop factor
@@ -146,7 +146,7 @@ TEST(SGraphBackground, TheResultDoesNotDependOnWhoRanIt) {
   ASSERT_TRUE(job_b.Init(config));
   ASSERT_TRUE(a.graph.BeginFullSolve(job_a));
   ASSERT_TRUE(b.graph.BeginFullSolve(job_b));
-  std::thread worker([&job_a] {
+  std::jthread worker([&job_a] {
     if (job_a.TryClaim()) job_a.Run();
   });
   // Keyframes keep coming meanwhile (no local solves here: their time limit would make the two

@@ -202,6 +202,7 @@ int main(int argc, char** argv) {
     world = sim::LoadWorld((fs::path(run) / "world.world").string(), world_error);
   core::LocalMapper mapper;
   std::jthread solver;  // the background full solve's runner (joined before the mapper goes)
+  std::uint64_t solves_begun = 0;
   if (auto s = mapper.Init(config); !s) {
     std::fprintf(stderr, "slam: %s\n", s.error().detail);
     return 1;
@@ -262,11 +263,15 @@ int main(int argc, char** argv) {
       timer.Sweep(std::chrono::duration<double, std::milli>(Clock::now() - sweep_start).count());
     // A full solve begun at this keyframe runs on its own thread, as in the node; the map does
     // not depend on it (the mapper applies it at a fixed keyframe, running it there if need be).
-    if (core::SGraphSolveJob* job = mapper.background_solve()) {
-      if (solver.joinable()) solver.join();
-      solver = std::jthread([job] {
-        if (job->TryClaim()) job->Run();
-      });
+    // One thread per job begun (the previous job was applied before this one began).
+    if (mapper.stats().full_solves_begun != solves_begun) {
+      solves_begun = mapper.stats().full_solves_begun;
+      if (core::SGraphSolveJob* job = mapper.background_solve()) {
+        if (solver.joinable()) solver.join();
+        solver = std::jthread([job] {
+          if (job->TryClaim()) job->Run();
+        });
+      }
     }
     const core::ScanMatchRecord& m = mapper.last_scan_match();
     if (matches != nullptr && outcome && *outcome == core::ScanOutcome::kKeyframe && m.attempted) {

@@ -45,6 +45,8 @@ SGraph::~SGraph() = default;
 Status SGraph::Init(const SGraphConfig& config) {
   if (auto s = config.Validate(); !s) return s;
   Impl& m = *impl_;
+  if (m.jobs_borrowing > 0)  // it would free the costs a job evaluates
+    return Error{Errc::kWouldBlock, "a background solve job borrows from this graph"};
   m.config = config;
   ceres::Problem::Options options;
   // The graph owns the costs (RetireCost): a background solve may still be evaluating one the
@@ -53,8 +55,7 @@ Status SGraph::Init(const SGraphConfig& config) {
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.enable_fast_removal = true;  // sparsification and room updates remove blocks
-  m.DeleteCosts();  // a second Init
-  m.jobs_borrowing = 0;
+  m.DeleteCosts();  // a second Init (no job borrows them: refused above)
   m.problem = std::make_unique<ceres::Problem>(options);
   m.huber_relative = std::make_unique<ceres::HuberLoss>(config.huber_relative_pose);
   m.huber_loop = std::make_unique<ceres::HuberLoss>(config.huber_loop_closure);
@@ -166,6 +167,13 @@ Expected<double> SGraph::FactorChi2(std::uint32_t factor) const {
     return Error{Errc::kDegenerate, "factor could not be evaluated"};
   }
   return 2.0 * cost;  // Ceres' cost is half the squared norm
+}
+
+bool SGraph::IsLoopFactor(std::uint32_t factor) const {
+  const Impl& m = *impl_;
+  if (factor >= m.factor_high_water || !m.factors[factor].active) return false;
+  const FactorRecord& f = m.factors[factor];
+  return f.kind == FactorKind::kRelative && f.relative == RelativePoseKind::kLoopClosure;
 }
 
 Status SGraph::RemoveFactor(std::uint32_t factor) {

@@ -2,10 +2,13 @@
 // The full solve in the background (s_graph_solve_job.hpp, docs/s-graph.md).
 //
 // The job holds two copies of every estimate: `begin` as the graph had it at BeginFullSolve,
-// and `solved`, which Run optimises in place. ApplyFullSolve uses the pair to carry what the
-// graph did in the meantime: a node the job held gets solved + (now - begin) (for a keyframe,
-// the correction T_solved T_begin^-1 applied on the left), and a node added since gets the
-// correction of the newest keyframe the job held, the one it was built on.
+// and `solved`, which Run optimises in place. ApplyFullSolve gives every keyframe and plane the
+// job held its solution: the local solves since may have pulled the newest of them towards a
+// loop closure the solution holds in full already, so adding their change would count that
+// pull twice; the next local solve brings back what the observations since say. A node added
+// since moves with the newest keyframe the job held (the anchor), from where the anchor is now
+// to its solution: it keeps its pose relative to the keyframe it was built on. Rooms and the
+// floor, which are re-centred by the room mapper between solves, get solved + (now - begin).
 #include <ceres/ceres.h>
 #include <ceres/sphere_manifold.h>
 
@@ -85,9 +88,6 @@ struct SGraphSolveJob::Impl {
   bool Held(std::size_t k, const KeyframeNode& now) const {
     return k < keyframe_slots && keyframe_in[k] && stamp[k] == now.stamp_s;
   }
-  Eigen::Isometry3d Correction(std::size_t k) const {
-    return solved.Pose(k) * begin.Pose(k).inverse();
-  }
 };
 
 SGraphSolveJob::SGraphSolveJob() : impl_(std::make_unique<Impl>()) {}
@@ -127,50 +127,54 @@ bool SGraphSolveJob::TryClaim() {
 void SGraphSolveJob::Run() {
   Impl& j = *impl_;
   Values& x = j.solved;
-  ceres::Problem::Options options;
-  // Everything is borrowed: the graph's costs and losses, the job's manifolds and memory.
-  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(options);
-  for (std::size_t k = 0; k < j.keyframe_slots; ++k) {
-    if (!j.keyframe_in[k]) continue;
-    problem.AddParameterBlock(&x.kq[4 * k], 4, &j.quaternion_manifold);
-    problem.AddParameterBlock(&x.kt[3 * k], 3);
-    if (static_cast<std::int32_t>(k) == j.origin) {  // the gauge, as in the graph
-      problem.SetParameterBlockConstant(&x.kq[4 * k]);
-      problem.SetParameterBlockConstant(&x.kt[3 * k]);
-    }
-  }
-  for (std::size_t i = 0; i < j.plane_count; ++i) {
-    if (!j.plane_in[i]) continue;
-    problem.AddParameterBlock(&x.pn[3 * i], 3, &j.sphere_manifold);
-    problem.AddParameterBlock(&x.pd[i], 1);
-  }
-  for (std::size_t i = 0; i < j.room_count; ++i)
-    if (j.room_in[i]) problem.AddParameterBlock(&x.rc[2 * i], 2);
-  if (j.floor_in) problem.AddParameterBlock(x.floor, 2);
-  for (const JobResidual& r : j.residuals) {
-    problem.AddResidualBlock(const_cast<ceres::CostFunction*>(r.cost),
-                             const_cast<ceres::LossFunction*>(r.loss), j.refs.data() + r.first,
-                             static_cast<int>(r.count));
-  }
   SGraphSolveReport report;
-  report.kind = SolveKind::kFull;
-  std::size_t keyframes = 0;
-  for (std::size_t k = 0; k < j.keyframe_slots; ++k) keyframes += j.keyframe_in[k];
-  report.free_keyframes = keyframes > 0 ? keyframes - 1 : 0;
-  if (problem.NumResidualBlocks() == 0) {
-    report.usable = report.converged = true;
-  } else {
-    ceres::Solver::Summary summary;
-    ceres::Solve(sgraph::SolverOptions(j.config, SolveKind::kFull), &problem, &summary);
-    report.iterations = static_cast<int>(summary.iterations.size());
-    report.initial_cost = summary.initial_cost;
-    report.final_cost = summary.final_cost;
-    report.seconds = summary.total_time_in_seconds;
-    report.converged = summary.termination_type == ceres::CONVERGENCE;
-    report.usable = sgraph::SolverFinished(summary) && x.Finite();
+  // The problem lives in this scope only: "done" is published after it is gone, so a caller
+  // that saw done may drop the job.
+  {
+    ceres::Problem::Options options;
+    // Everything is borrowed: the graph's costs and losses, the job's manifolds and memory.
+    options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(options);
+    for (std::size_t k = 0; k < j.keyframe_slots; ++k) {
+      if (!j.keyframe_in[k]) continue;
+      problem.AddParameterBlock(&x.kq[4 * k], 4, &j.quaternion_manifold);
+      problem.AddParameterBlock(&x.kt[3 * k], 3);
+      if (static_cast<std::int32_t>(k) == j.origin) {  // the gauge, as in the graph
+        problem.SetParameterBlockConstant(&x.kq[4 * k]);
+        problem.SetParameterBlockConstant(&x.kt[3 * k]);
+      }
+    }
+    for (std::size_t i = 0; i < j.plane_count; ++i) {
+      if (!j.plane_in[i]) continue;
+      problem.AddParameterBlock(&x.pn[3 * i], 3, &j.sphere_manifold);
+      problem.AddParameterBlock(&x.pd[i], 1);
+    }
+    for (std::size_t i = 0; i < j.room_count; ++i)
+      if (j.room_in[i]) problem.AddParameterBlock(&x.rc[2 * i], 2);
+    if (j.floor_in) problem.AddParameterBlock(x.floor, 2);
+    for (const JobResidual& r : j.residuals) {
+      problem.AddResidualBlock(const_cast<ceres::CostFunction*>(r.cost),
+                               const_cast<ceres::LossFunction*>(r.loss), j.refs.data() + r.first,
+                               static_cast<int>(r.count));
+    }
+    report.kind = SolveKind::kFull;
+    std::size_t keyframes = 0;
+    for (std::size_t k = 0; k < j.keyframe_slots; ++k) keyframes += j.keyframe_in[k];
+    report.free_keyframes = keyframes > 0 ? keyframes - 1 : 0;
+    if (problem.NumResidualBlocks() == 0) {
+      report.usable = report.converged = true;
+    } else {
+      ceres::Solver::Summary summary;
+      ceres::Solve(sgraph::SolverOptions(j.config, SolveKind::kFull), &problem, &summary);
+      report.iterations = static_cast<int>(summary.iterations.size());
+      report.initial_cost = summary.initial_cost;
+      report.final_cost = summary.final_cost;
+      report.seconds = summary.total_time_in_seconds;
+      report.converged = summary.termination_type == ceres::CONVERGENCE;
+      report.usable = sgraph::SolverFinished(summary) && x.Finite();
+    }
   }
   j.report = report;
   j.state.store(kDone, std::memory_order_release);
@@ -283,6 +287,8 @@ Expected<double> SGraph::FactorChi2(const SGraphSolveJob& job, std::uint32_t fac
   const SGraphSolveJob::Impl& j = *job.impl_;
   if (j.graph != this || j.state.load(std::memory_order_acquire) != kDone)
     return Error{Errc::kInvalidArgument, "solve job not done on this graph"};
+  if (!j.report.usable)  // a failed solve judges nothing
+    return Error{Errc::kNotConverged, "the solve job's solution is not usable"};
   if (factor >= m.factor_high_water || !m.factors[factor].active)
     return Error{Errc::kNotFound, "no such factor"};
   const ceres::ResidualBlockId id = m.factors[factor].id;
@@ -333,32 +339,42 @@ Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
   while (anchor != kNone &&
          !j.Held(static_cast<std::size_t>(anchor), m.keyframes[static_cast<std::size_t>(anchor)]))
     anchor = m.keyframes[static_cast<std::size_t>(anchor)].prev;
+  // What carries a newer node: the anchor from where it is now to where the solve puts it.
   const Eigen::Isometry3d C_anchor = anchor != kNone
-                                         ? j.Correction(static_cast<std::size_t>(anchor))
+                                         ? j.solved.Pose(static_cast<std::size_t>(anchor)) *
+                                               m.Pose(static_cast<std::uint32_t>(anchor)).inverse()
                                          : Eigen::Isometry3d::Identity();
+  // The anchor's height before the correction (C_anchor maps from there): for rooms, in 2-D.
+  const double anchor_z_m =
+      anchor != kNone ? m.keyframes[static_cast<std::size_t>(anchor)].t[2] : 0.0;
+  const Values& b = j.begin;
+  const Values& x = j.solved;
   for (std::size_t k = 0; k < m.keyframe_high_water; ++k) {
     KeyframeNode& node = m.keyframes[k];
     if (!node.active) continue;
-    const Eigen::Isometry3d C = j.Held(k, node) ? j.Correction(k) : C_anchor;
-    SetPose(node, C * m.Pose(static_cast<std::uint32_t>(k)));
+    if (j.Held(k, node)) {
+      // The solution itself: the local solves since may have pulled this keyframe towards a
+      // loop the solution holds in full already. The next local solve brings back what newer
+      // observations say.
+      std::copy(&x.kq[4 * k], &x.kq[4 * k] + 4, node.q);
+      std::copy(&x.kt[3 * k], &x.kt[3 * k] + 3, node.t);
+    } else {
+      SetPose(node, C_anchor * m.Pose(static_cast<std::uint32_t>(k)));
+    }
   }
-  const Values& b = j.begin;
-  const Values& x = j.solved;
   for (std::size_t i = 0; i < m.plane_count; ++i) {
     PlaneNode& p = m.planes[i];
     if (!p.in_problem) continue;
-    Eigen::Vector3d n(p.n[0], p.n[1], p.n[2]);
-    double d = p.d[0];
     if (i < j.plane_count && j.plane_in[i]) {
-      n += Eigen::Vector3d(&x.pn[3 * i]) - Eigen::Vector3d(&b.pn[3 * i]);
-      d += x.pd[i] - b.pd[i];
-    } else {  // n.p + d = 0 carried by p' = C p
-      n = C_anchor.linear() * n;
-      d -= n.dot(C_anchor.translation());
+      std::copy(&x.pn[3 * i], &x.pn[3 * i] + 3, p.n);
+      p.d[0] = x.pd[i];
+      continue;
     }
-    n.normalize();
+    // n.p + d = 0 carried by p' = C p: n' = R n, d' = d - n'.t.
+    const Eigen::Vector3d n =
+        (C_anchor.linear() * Eigen::Vector3d(p.n[0], p.n[1], p.n[2])).normalized();
+    p.d[0] -= n.dot(C_anchor.translation());
     std::copy(n.data(), n.data() + 3, p.n);
-    p.d[0] = d;
   }
   const auto carry = [&](double* c, const double* c_begin, const double* c_solved, bool held) {
     if (held) {
@@ -366,8 +382,7 @@ Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
       c[1] += c_solved[1] - c_begin[1];
       return;
     }
-    const double z = anchor != kNone ? b.kt[3 * static_cast<std::size_t>(anchor) + 2] : 0.0;
-    const Eigen::Vector3d moved = C_anchor * Eigen::Vector3d(c[0], c[1], z);
+    const Eigen::Vector3d moved = C_anchor * Eigen::Vector3d(c[0], c[1], anchor_z_m);
     c[0] = moved.x();
     c[1] = moved.y();
   };

@@ -55,6 +55,12 @@ Status LocalMapperConfig::Validate() const {
     return Error{Errc::kInvalidConfig,
                  "mapper: spacing, voxels, ranges, sigmas and capacities must be positive"};
   }
+  // A loop waits up to twice the lag for its judgement; its keyframes must still be in the
+  // local window then, never sparsified.
+  if (2 * full_solve_lag_keyframes >= graph.local_window_keyframes) {
+    return Error{Errc::kInvalidConfig,
+                 "mapper: full_solve_lag_keyframes must be below half the graph's local window"};
+  }
   for (const Status& s :
        {graph.Validate(), planes.Validate(), association.Validate(), rooms.Validate(),
         grid.Validate(), loops.Validate(), scan_matching.Validate(),

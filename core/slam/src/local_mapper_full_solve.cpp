@@ -10,8 +10,9 @@
 // keyframes, never time, so the same keyframes make the same map whoever runs the job and
 // whenever: a journal replay rebuilds the live map. A loop closure found meanwhile waits for the
 // next job; each is judged by the solve that included it before that solve is applied, and a
-// contradicted one is removed and the solve dropped (another begins at once without it), so
-// a false loop never pulls the map.
+// contradicted one is removed and the solve dropped (another begins at once without it), so a
+// false loop never reaches the map through a full solve. Until it is judged it is in the graph
+// and pulls the local window (Huber 1), as on the spot it would not.
 #include "msgraphs/core/slam/local_mapper.hpp"
 
 namespace msgraphs::core {
@@ -47,6 +48,7 @@ void LocalMapper::ScheduleFullSolve(bool loop) {
 
 void LocalMapper::BeginBackgroundSolve() {
   if (!graph_.BeginFullSolve(full_job_)) return;  // never: one job at a time, sized at Init
+  ++stats_.full_solves_begun;
   job_loops_.clear();
   for (std::uint32_t f : pending_loops_) static_cast<void>(job_loops_.try_push_back(f));
   pending_loops_.clear();
@@ -58,20 +60,30 @@ void LocalMapper::ApplyBackgroundSolve() {
   if (!full_job_.done()) ++stats_.full_solves_waited;
   full_job_.Complete();  // runs it here if nobody claimed it, else waits for its runner
   ++stats_.full_solves;
-  bool refused = false;
-  for (std::uint32_t f : job_loops_)
-    refused = loops_.RejectIfContradicted(graph_, f, &full_job_) || refused;
-  if (refused) {
-    // The solve was pulled by a loop now removed: solve again without it, at once.
+  if (!full_job_.report().usable) {
+    // A failed solve judges nothing and is not applied: its loops wait for the next one.
     graph_.DropFullSolve(full_job_);
+    ++stats_.full_solves_unusable;
     for (std::uint32_t f : job_loops_)
-      if (graph_.FactorChi2(f)) ++stats_.loop_closures;  // the others stand
+      if (!pending_loops_.try_push_back(f)) ++stats_.loops_unchecked;
+    job_loops_.clear();
     full_wanted_ = true;
-  } else {
-    if (graph_.ApplyFullSolve(full_job_)) ++stats_.full_solves_background;
-    stats_.loop_closures += job_loops_.size();
+    return;
+  }
+  bool refused = false;
+  for (std::uint32_t f : job_loops_) {
+    const bool out = loops_.RejectIfContradicted(graph_, f, &full_job_);
+    refused = refused || out;
+    if (!out && graph_.IsLoopFactor(f)) ++stats_.loop_closures;  // it stands
   }
   job_loops_.clear();
+  if (refused) {
+    // The solve was pulled by a loop now removed: drop it and solve again without, at once.
+    graph_.DropFullSolve(full_job_);
+    full_wanted_ = true;
+  } else if (graph_.ApplyFullSolve(full_job_)) {
+    ++stats_.full_solves_background;
+  }
 }
 
 }  // namespace msgraphs::core

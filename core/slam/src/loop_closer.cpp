@@ -165,6 +165,7 @@ bool LoopCloser::RejectIfContradicted(SGraph& graph) {
 bool LoopCloser::RejectIfContradicted(SGraph& graph,
                                       std::uint32_t factor,
                                       const SGraphSolveJob* job) {
+  if (!graph.IsLoopFactor(factor)) return false;  // freed by sparsification (and maybe reused)
   const auto chi2 = job != nullptr ? graph.FactorChi2(*job, factor) : graph.FactorChi2(factor);
   if (!chi2 || *chi2 <= config_.max_chi2_after_solve) return false;
   if (!graph.RemoveFactor(factor)) return false;

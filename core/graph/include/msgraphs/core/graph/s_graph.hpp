@@ -172,6 +172,7 @@ class SGraph {
   SGraph(const SGraph&) = delete;
   SGraph& operator=(const SGraph&) = delete;
 
+  /// kWouldBlock while a background solve job borrows from this graph (apply or drop it first).
   Status Init(const SGraphConfig& config);
 
   /// A new keyframe with its initial estimate. The first one becomes the origin (held fixed).
@@ -234,17 +235,22 @@ class SGraph {
   /// full solve elsewhere. kWouldBlock while another job is pending on this graph;
   /// kInvalidArgument when the job was sized for a smaller graph. No allocation.
   Status BeginFullSolve(SGraphSolveJob& job);
-  /// After job.Complete(): puts the solution back. Every node the job held takes the solution
-  /// plus what the graph did to it since the copy (local solves, a room re-centred); keyframes,
-  /// planes, rooms and the floor added since move rigidly with the newest keyframe the job held
-  /// that is still in the graph. An unusable solve (non-finite, failed) is not applied: the
-  /// report says so and the graph is as it was. Either way the job is finished.
+  /// After job.Complete(): puts the solution back. Keyframes and planes the job held take the
+  /// solution; rooms and the floor the solution plus what the graph did to them since the copy
+  /// (re-centred); keyframes, planes, rooms added since move rigidly with the newest keyframe
+  /// the job held that is still in the graph, from where it is now to its solution. An
+  /// unusable solve (non-finite, failed) is not applied: the report says so and the graph is as
+  /// it was. Either way the job is finished.
   Expected<SGraphSolveReport> ApplyFullSolve(SGraphSolveJob& job);
   /// Finishes a job without applying it (after Complete, or before anybody claimed it).
   void DropFullSolve(SGraphSolveJob& job);
   /// FactorChi2 at the job's solution (done jobs only): how the solve that included the factor
-  /// judges it, before applying. kNotFound when the factor was not in the job or was removed.
+  /// judges it, before applying. kNotFound when the factor was not in the job or was removed;
+  /// kNotConverged when the job's solution is not usable (it judges nothing).
   Expected<double> FactorChi2(const SGraphSolveJob& job, std::uint32_t factor) const;
+  /// Whether `factor` is an active loop-closure factor (a factor id kept across keyframes may
+  /// have been freed by sparsification and reused by another factor).
+  bool IsLoopFactor(std::uint32_t factor) const;
 
   // ---- state ----
   std::size_t keyframe_slots() const;  ///< ids handed out so far (active or sparsified)

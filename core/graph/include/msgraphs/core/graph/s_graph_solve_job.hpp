@@ -9,9 +9,10 @@
 // - Run (any thread) solves that copy while the graph goes on taking keyframes, local solves
 //   and removals. It touches only the job's memory and the graph's cost functions and losses,
 //   which never change once made; the graph keeps every one it removes while a job borrows them;
-// - SGraph::ApplyFullSolve (the graph's thread) puts the solution back, carrying what the
-//   graph did since: nodes in the job take the solution plus their own change since the copy,
-//   nodes added since move rigidly with the newest keyframe the job held.
+// - SGraph::ApplyFullSolve (the graph's thread) puts the solution back: keyframes and planes in
+//   the job take the solution, nodes added since move rigidly with the newest keyframe the job
+//   held (from where it is now to its solution), rooms and the floor take the solution plus
+//   their change since the copy.
 //
 // Who runs it: whoever claims it first. A worker thread calls TryClaim and then Run; the graph's
 // thread calls Complete at its apply point, which runs the job itself if nobody claimed it and
@@ -20,7 +21,10 @@
 //
 // Memory: Init sizes the copy from the graph's config (allocates); BeginFullSolve and
 // ApplyFullSolve do not allocate beyond that. Run allocates (it builds a Ceres problem): it is
-// the background path. The graph must outlive a job that borrows from it.
+// the background path. The graph must outlive a job that borrows from it, and a job must be
+// applied or dropped before its graph is re-initialised (SGraph::Init refuses) or destroyed;
+// a thread that runs a job must be joined before the job is destroyed (Run touches the job
+// after it has published "done").
 #pragma once
 
 #include <memory>

@@ -135,6 +135,8 @@ struct LocalMapperConfig {
   /// second walking and one every 0.35 s turning on the spot (1 rad/s), so 1.75 s at least,
   /// against 0.3 s for a full solve at 4,000 keyframes (docs/performance.md). A late one makes
   /// the mapper wait at that keyframe (counted: full_solves_waited), never a different map.
+  /// Below half the graph's local window (validated): a loop waits up to twice the lag for its
+  /// judgement, and its keyframes must not be sparsified meanwhile.
   std::size_t full_solve_lag_keyframes = 5;
   std::size_t max_plane_priors = 256;  ///< external wall priors held at once (SetPlanePriors)
   std::size_t cloud_store_points = 1500000;
@@ -225,6 +227,9 @@ struct LocalMapperStats {
   /// Full solves in the background (full_solve_lag_keyframes > 0): applied; and of all begun,
   /// those the mapper had to run itself or wait for at their keyframe (nobody ran them in time).
   std::uint64_t full_solves_background = 0, full_solves_waited = 0;
+  /// Background full solves begun, and those whose solve failed (not applied; their loops wait
+  /// for the next).
+  std::uint64_t full_solves_begun = 0, full_solves_unusable = 0;
   /// Loop closures found while more than loop_checks_capacity waited for their solve: applied
   /// without the contradiction check.
   std::uint64_t loops_unchecked = 0;
