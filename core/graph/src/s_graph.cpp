@@ -122,12 +122,7 @@ Expected<std::uint32_t> SGraph::AddKeyframe(double stamp_s,
                   "s-graph keyframe slot beyond the store");
   KeyframeNode& k = m.keyframes[static_cast<std::size_t>(slot)];
   k = KeyframeNode{};
-  const Eigen::Quaterniond q(T_map_keyframe.linear());
-  k.q[0] = q.x();
-  k.q[1] = q.y();
-  k.q[2] = q.z();
-  k.q[3] = q.w();
-  for (int i = 0; i < 3; ++i) k.t[i] = T_map_keyframe.translation()[i];
+  m.SetPose(static_cast<std::uint32_t>(slot), T_map_keyframe);
   k.stamp_s = stamp_s;
   k.prev = m.newest;
   k.active = true;

@@ -33,14 +33,7 @@ struct Values {
   std::vector<double> kq, kt, pn, pd, rc;
   double floor[2] = {0, 0};
 
-  Eigen::Isometry3d Pose(std::size_t k) const {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(kq[4 * k + 3], kq[4 * k], kq[4 * k + 1], kq[4 * k + 2])
-                     .normalized()
-                     .toRotationMatrix();
-    T.translation() = Eigen::Vector3d(kt[3 * k], kt[3 * k + 1], kt[3 * k + 2]);
-    return T;
-  }
+  Eigen::Isometry3d Pose(std::size_t k) const { return sgraph::PoseOf(&kq[4 * k], &kt[3 * k]); }
   bool Finite() const {
     for (const auto* v : {&kq, &kt, &pn, &pd, &rc})
       for (double x : *v)
@@ -55,15 +48,6 @@ struct JobResidual {
   ceres::ResidualBlockId id = nullptr;  // in the graph's problem: FactorChi2 finds it by this
   std::uint32_t first = 0, count = 0;   // its parameter blocks: refs[first, first + count)
 };
-
-void SetPose(KeyframeNode& k, const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.linear());
-  k.q[0] = q.x();
-  k.q[1] = q.y();
-  k.q[2] = q.z();
-  k.q[3] = q.w();
-  for (int i = 0; i < 3; ++i) k.t[i] = T.translation()[i];
-}
 
 }  // namespace
 
@@ -359,7 +343,7 @@ Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
       std::copy(&x.kq[4 * k], &x.kq[4 * k] + 4, node.q);
       std::copy(&x.kt[3 * k], &x.kt[3 * k] + 3, node.t);
     } else {
-      SetPose(node, C_anchor * m.Pose(static_cast<std::uint32_t>(k)));
+      m.SetPose(static_cast<std::uint32_t>(k), C_anchor * m.Pose(static_cast<std::uint32_t>(k)));
     }
   }
   for (std::size_t i = 0; i < m.plane_count; ++i) {

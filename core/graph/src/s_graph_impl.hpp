@@ -111,6 +111,22 @@ inline Eigen::Isometry3d Fuse(const Eigen::Isometry3d& Z_a,
   return step.allFinite() ? Eigen::Isometry3d(Z_a * Se3Exp(step)) : Z_a;
 }
 
+// A keyframe's parameter blocks (quaternion x y z w, translation) as a pose, and back.
+inline Eigen::Isometry3d PoseOf(const double* q, const double* t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return T;
+}
+inline void StorePose(const Eigen::Isometry3d& T, double* q, double* t) {
+  const Eigen::Quaterniond r(T.linear());
+  q[0] = r.x();
+  q[1] = r.y();
+  q[2] = r.z();
+  q[3] = r.w();
+  for (int i = 0; i < 3; ++i) t[i] = T.translation()[i];
+}
+
 // The solver's options for either solve (s_graph_solve.cpp).
 ceres::Solver::Options SolverOptions(const SGraphConfig& config, SolveKind kind);
 // The solver stopped with a state worth keeping (converged, or at its limits, with a finite cost).
@@ -195,11 +211,10 @@ struct SGraph::Impl {
   bool ValidRoom(std::uint32_t id) const { return id < room_count && rooms[id].info.active; }
 
   Eigen::Isometry3d Pose(std::uint32_t id) const {
-    const KeyframeNode& k = keyframes[id];
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::Quaterniond(k.q[3], k.q[0], k.q[1], k.q[2]).normalized().toRotationMatrix();
-    T.translation() = Eigen::Vector3d(k.t[0], k.t[1], k.t[2]);
-    return T;
+    return sgraph::PoseOf(keyframes[id].q, keyframes[id].t);
+  }
+  void SetPose(std::uint32_t id, const Eigen::Isometry3d& T) {
+    sgraph::StorePose(T, keyframes[id].q, keyframes[id].t);
   }
 
   Expected<std::int32_t> NewFactor(FactorKind kind, std::uint32_t a, std::uint32_t b) {
