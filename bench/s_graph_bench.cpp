@@ -233,4 +233,54 @@ BENCHMARK(BM_SGraphBackgroundSolve)
     ->Arg(4000)
     ->Iterations(10)->Unit(benchmark::kMillisecond);
 
+// The walls' marginal covariances as the distiller asks for them at an exchange: every wall seen
+// so far, from one factorisation of the whole graph (SGraph::PlaneMarginals: what the exchange
+// computed on the SLAM thread before), and the SLAM thread's share now that a marginals job
+// computes them elsewhere (begin: BeginPlaneMarginals' copy).
+void BM_SGraphPlaneMarginals(benchmark::State& state) {
+  const auto keyframes = static_cast<std::size_t>(state.range(0));
+  Building b(keyframes);
+  for (std::size_t i = 0; i < keyframes; ++i) b.AddKeyframe();
+  std::vector<std::uint32_t> walls;
+  for (std::uint32_t id = 0; id < b.graph.plane_slots(); ++id) {
+    const MapPlane p = b.graph.plane(id);
+    if (p.active && p.plane_class == PlaneClass::kWall && p.observations > 0) walls.push_back(id);
+  }
+  std::vector<Eigen::Matrix3d> covariances(walls.size());
+  SGraphSolveJob job;
+  if (!job.Init(b.graph.config())) {
+    state.SkipWithError("job init");
+    return;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  };
+  std::vector<double> marginals_ms, begin_ms;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    benchmark::DoNotOptimize(b.graph.PlaneMarginals(walls, covariances));
+    marginals_ms.push_back(since(t0));
+    t0 = Clock::now();
+    static_cast<void>(b.graph.BeginPlaneMarginals(job, walls));
+    begin_ms.push_back(since(t0));
+    static_cast<void>(job.Release());  // not run: only the copy is timed
+  }
+  std::sort(marginals_ms.begin(), marginals_ms.end());
+  std::sort(begin_ms.begin(), begin_ms.end());
+  state.counters["walls"] = static_cast<double>(walls.size());
+  if (!begin_ms.empty()) {
+    state.counters["p50_ms"] = marginals_ms[marginals_ms.size() / 2];
+    state.counters["max_ms"] = marginals_ms.back();
+    state.counters["begin_p50_ms"] = begin_ms[begin_ms.size() / 2];
+    state.counters["begin_max_ms"] = begin_ms.back();
+  }
+}
+BENCHMARK(BM_SGraphPlaneMarginals)
+    ->Arg(300)
+    ->Arg(500)
+    ->Arg(2000)
+    ->Arg(4000)
+    ->Iterations(5)->Unit(benchmark::kMillisecond);
+
 }  // namespace

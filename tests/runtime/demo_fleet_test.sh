@@ -36,6 +36,10 @@ done
 awk '$1 == "full_solves_background" { b = $2 } $1 == "solver_thread_runs" { r = $2 }
      END { printf "full solves: %d applied from the background, %d run by the solver thread\n", b, r; exit !(b > 0 && r > 0) }' \
   "$out/nodes/robot1/stats.txt" || { echo "no full solve ran on the solver thread"; rc=1; }
+# The walls' marginal covariances ran off the SLAM thread too.
+awk '$1 == "marginal_updates" { u = $2 } $1 == "marginals_thread_runs" { r = $2 }
+     END { printf "wall marginals: %d computed, %d on the marginals thread\n", u, r; exit !(u > 0 && r > 0) }' \
+  "$out/nodes/robot1/stats.txt" || { echo "no wall marginals ran on the marginals thread"; rc=1; }
 # g2o: every edge names vertices defined above it, the fixed vertex exists.
 awk '/^VERTEX_/ { v[$2] = 1; vertices++ }
      /^EDGE_SE3:QUAT|^EDGE_SE3_TRACKXYZ|^EDGE_POINTXYZ/ { edges++; if (!($2 in v) || !($3 in v)) bad = 1 }

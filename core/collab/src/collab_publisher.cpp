@@ -58,12 +58,18 @@ Status CollabPublisher::Init(const CollabSessionConfig& config_in,
   return Ok();
 }
 
-void CollabPublisher::Prepare(const LocalMapper& mapper, CollabExchange& out) {
+void CollabPublisher::Prepare(const LocalMapper& mapper,
+                              CollabExchange& out,
+                              MarginalsTiming marginals) {
   out.Clear();
   ++stats_.prepares;
-  out.graph_changed = distiller_.Update(mapper.graph(), mapper.plane_mapper());
-  stats_.marginal_updates = distiller_.stats().marginal_updates;
-  stats_.marginal_failures = distiller_.stats().marginal_failures;
+  out.graph_changed = distiller_.Update(mapper.graph(), mapper.plane_mapper(), marginals);
+  const Distiller::Stats& d = distiller_.stats();
+  stats_.marginal_updates = d.marginal_updates;
+  stats_.marginal_failures = d.marginal_failures;
+  stats_.marginals_run_at_prepare = d.marginals_run_at_update;
+  stats_.marginals_not_ready = d.marginals_not_ready;
+  stats_.walls_awaiting_marginals = d.walls_awaiting_marginals;
   const DistilledGraph& g = distiller_.graph();
   out.graph.CopyFrom(g);  // capacities sized alike
 
@@ -145,10 +151,11 @@ Status PublishNow(const LocalMapper& mapper,
                   CollabPublisher& publisher,
                   CollabExchange& exchange,
                   CollabSession& session,
-                  CollabOutbox& out) {
+                  CollabOutbox& out,
+                  MarginalsTiming marginals) {
   exchange.requests.clear();
   session.TakePlaceRequests(exchange.requests);
-  publisher.Prepare(mapper, exchange);
+  publisher.Prepare(mapper, exchange, marginals);
   return session.Ingest(exchange, publisher.stats(), out);
 }
 

@@ -14,10 +14,16 @@ Status DistillerConfig::Validate() const {
   return Ok();
 }
 
+Distiller::~Distiller() { static_cast<void>(job_.Release()); }
+
 Status Distiller::Init(std::uint16_t robot,
                        const SGraphConfig& graph,
                        const DistillerConfig& config) {
   if (auto s = config.Validate(); !s) return s;
+  static_cast<void>(job_.Release());  // a job from a previous Init
+  if (config.marginal_covariances) {
+    if (auto s = job_.Init(graph); !s) return s;
+  }
   config_ = config;
   out_.Init(config.max_walls, config.max_rooms);
   out_.robot = robot;
@@ -25,24 +31,46 @@ Status Distiller::Init(std::uint16_t robot,
   room_slot_.assign(graph.max_rooms, -1);
   needed_.assign(graph.max_planes, 0);
   eligible_.Init(graph.max_planes);
-  marginals_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
+  marginal_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
+  now_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
+  marginal_known_.assign(graph.max_planes, 0);
+  marginals_failed_ = false;
+  job_begun_once_ = false;
   stats_ = {};
   updated_once_ = false;
   return Ok();
 }
 
-bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
-  // The S-Graph as it was at the last Update: the distilled graph would come out the same, and the
-  // marginals (one factorisation of the whole problem) are not recomputed.
-  const std::uint64_t revision = graph.stats().revision;
-  if (updated_once_ && revision == revision_) {
-    ++stats_.unchanged;
-    return false;
+bool Distiller::CollectMarginals() {
+  if (!job_.pending()) return false;
+  if (!job_.done()) {
+    if (!job_.TryClaim()) {
+      // A runner has it: never wait on it here; a later Update takes it (and begins no other
+      // meanwhile).
+      ++stats_.marginals_not_ready;
+      return false;
+    }
+    job_.Run();  // nobody took it: the same result, on this thread
+    ++stats_.marginals_run_at_update;
   }
-  updated_once_ = true;
-  revision_ = revision;
-  const std::uint32_t next = out_.version + 1;
-  bool changed = false;
+  const auto ids = job_.marginal_planes();
+  const auto covariances = job_.plane_marginals();
+  marginals_failed_ = covariances.size() != ids.size();
+  if (marginals_failed_) {
+    ++stats_.marginal_failures;
+  } else {
+    ++stats_.marginal_updates;
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      if (ids[i] >= marginal_.size()) continue;
+      marginal_[ids[i]] = covariances[i];
+      marginal_known_[ids[i]] = 1;
+    }
+  }
+  static_cast<void>(job_.Release());
+  return true;
+}
+
+void Distiller::FindEligible(const SGraph& graph) {
   // Walls the rooms stand on are always shared.
   std::fill(needed_.begin(), needed_.end(), 0);
   for (std::uint32_t r = 0; r < graph.room_slots(); ++r) {
@@ -53,7 +81,6 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
         needed_[static_cast<std::size_t>(w)] = 1;
     }
   }
-  // The walls to share, then their marginal covariances from one factorisation.
   eligible_.clear();
   for (std::uint32_t id = 0; id < graph.plane_slots() && id < wall_slot_.size(); ++id) {
     const MapPlane p = graph.plane(id);
@@ -63,20 +90,78 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes) {
     if (llt.info() != Eigen::Success) continue;  // not yet constrained in every direction
     eligible_.push_back(id);
   }
-  bool marginals = false;
-  if (config_.marginal_covariances && !eligible_.empty()) {
-    marginals = static_cast<bool>(graph.PlaneMarginals(eligible_.span(), marginals_));
-    if (marginals)
-      ++stats_.marginal_updates;
-    else
-      ++stats_.marginal_failures;  // the conditional covariances stand in
+}
+
+bool Distiller::BeginMarginals(const SGraph& graph) {
+  if (!config_.marginal_covariances || job_.pending()) return false;
+  const std::uint64_t revision = graph.stats().revision;
+  if (job_begun_once_ && revision == job_revision_) return false;  // they are known
+  FindEligible(graph);
+  if (eligible_.empty()) return false;
+  if (!graph.BeginPlaneMarginals(job_, eligible_.span())) {
+    marginals_failed_ = true;  // the conditional covariances stand in until one succeeds
+    ++stats_.marginal_failures;
+    return false;
   }
+  job_begun_once_ = true;
+  job_revision_ = revision;
+  ++stats_.marginals_begun;
+  return true;
+}
+
+void Distiller::MarginalsNow(const SGraph& graph) {
+  // On the graph's own problem, as before the background path existed (the job's copy gives
+  // the same to rounding; this keeps the evaluation's lock-step missions bit for bit).
+  marginals_failed_ = !graph.PlaneMarginals(eligible_.span(), now_);
+  if (marginals_failed_) {
+    ++stats_.marginal_failures;
+    return;
+  }
+  ++stats_.marginal_updates;
+  for (std::size_t i = 0; i < eligible_.size(); ++i) {
+    marginal_[eligible_[i]] = now_[i];
+    marginal_known_[eligible_[i]] = 1;
+  }
+}
+
+bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, MarginalsTiming timing) {
+  const bool background = config_.marginal_covariances && timing == MarginalsTiming::kBackground;
+  // The marginals begun at the last Update (normally run by another thread meanwhile). A kNow
+  // Update computes its own: an older job is released, not run.
+  bool fresh = false;
+  if (background)
+    fresh = CollectMarginals();
+  else
+    static_cast<void>(job_.Release());
+  // The S-Graph as it was at the last Update and no new marginals: the distilled graph would
+  // come out the same.
+  const std::uint64_t revision = graph.stats().revision;
+  if (updated_once_ && revision == revision_ && !fresh) {
+    ++stats_.unchanged;
+    return false;
+  }
+  updated_once_ = true;
+  revision_ = revision;
+  const std::uint32_t next = out_.version + 1;
+  bool changed = false;
+  // The walls to share, then (kNow) their marginal covariances from one factorisation.
+  FindEligible(graph);
+  if (config_.marginal_covariances && !background && !eligible_.empty()) MarginalsNow(graph);
   for (std::size_t i = 0; i < eligible_.size(); ++i) {
     const std::uint32_t id = eligible_[i];
     const MapPlane p = graph.plane(id);
+    // Its marginal: kNow's just computed, or kBackground's from the job BeginMarginals began.
+    // Without one, after a failed computation the conditional covariance stands in; otherwise a
+    // wall new since the job's copy waits for the next, never goes out overconfident.
+    const bool known = config_.marginal_covariances && marginal_known_[id] != 0 &&
+                       !(marginals_failed_ && !background);
+    if (config_.marginal_covariances && !known && !marginals_failed_) {
+      ++stats_.walls_awaiting_marginals;
+      continue;
+    }
     Eigen::Matrix3d covariance =
-        marginals ? marginals_[i]
-                  : Eigen::Matrix3d(p.information.llt().solve(Eigen::Matrix3d::Identity()));
+        known ? marginal_[id]
+              : Eigen::Matrix3d(p.information.llt().solve(Eigen::Matrix3d::Identity()));
     // Symmetric, and definite after the wire's f32 rounding: a 10 um / 10 urad floor.
     covariance = 0.5 * (covariance + covariance.transpose()).eval();
     covariance.diagonal().array() += 1e-10;

@@ -12,6 +12,7 @@
 #include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/graph/distilled_graph.hpp"
+#include "s_graph_covariance.hpp"
 #include "s_graph_factors.hpp"
 #include "s_graph_impl.hpp"
 
@@ -45,7 +46,7 @@ SGraph::~SGraph() = default;
 Status SGraph::Init(const SGraphConfig& config) {
   if (auto s = config.Validate(); !s) return s;
   Impl& m = *impl_;
-  if (m.jobs_borrowing > 0)  // it would free the costs a job evaluates
+  if (m.OldestBorrower() != Impl::kNoBorrower)  // it would free the costs a job evaluates
     return Error{Errc::kWouldBlock, "a background solve job borrows from this graph"};
   m.config = config;
   ceres::Problem::Options options;
@@ -504,53 +505,20 @@ MapPlane SGraph::plane(std::uint32_t id) const {
 Status SGraph::PlaneMarginals(std::span<const std::uint32_t> ids,
                               std::span<Eigen::Matrix3d> covariances) const {
   Impl& m = *impl_;
-  if (covariances.size() < ids.size())
-    return Error{Errc::kCapacityExceeded, "plane marginals: output shorter than the plane list"};
-  // Ceres recovers the marginals from one factorisation of the whole problem (SuiteSparse QR);
-  // it allocates, which is why this runs at the distillation cadence, not per keyframe.
-  std::vector<std::pair<const double*, const double*>> blocks;
-  blocks.reserve(ids.size() * 3);
+  // Ceres recovers the marginals from one factorisation of the whole problem; it allocates,
+  // which is why this runs at the distillation cadence, not per keyframe (and the distiller
+  // runs it in the background: BeginPlaneMarginals).
+  std::vector<sgraph::PlaneBlocks> planes;
+  planes.reserve(ids.size());
   for (std::uint32_t id : ids) {
     if (id >= m.plane_count || !m.planes[id].in_problem)
       return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
     const PlaneNode& p = m.planes[id];
-    blocks.emplace_back(p.n, p.n);
-    blocks.emplace_back(p.n, p.d);
-    blocks.emplace_back(p.d, p.d);
+    planes.push_back({p.n, p.d, p.info.basis_u, p.info.basis_v});
   }
-  if (ids.empty()) return Ok();
   // Every block but the origin's is variable in the graph's problem (local solves move a
   // window problem of their own), so the covariance is over the whole graph.
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = 1;
-  ceres::Covariance covariance(options);
-  if (!covariance.Compute(blocks, m.problem.get()))
-    return Error{Errc::kDegenerate, "plane marginals: the problem is rank deficient"};
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    const PlaneNode& p = m.planes[ids[i]];
-    // Ambient blocks (normal in R^3, offset), projected on the plane's own (u, v) basis.
-    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> nn;
-    Eigen::Vector3d nd;
-    double dd = 0;
-    if (!covariance.GetCovarianceBlock(p.n, p.n, nn.data()) ||
-        !covariance.GetCovarianceBlock(p.n, p.d, nd.data()) ||
-        !covariance.GetCovarianceBlock(p.d, p.d, &dd)) {
-      return Error{Errc::kDegenerate, "plane marginals: block not available"};
-    }
-    Eigen::Matrix4d full;
-    full.topLeftCorner<3, 3>() = nn;
-    full.topRightCorner<3, 1>() = nd;
-    full.bottomLeftCorner<1, 3>() = nd.transpose();
-    full(3, 3) = dd;
-    Eigen::Matrix<double, 3, 4> B = Eigen::Matrix<double, 3, 4>::Zero();
-    B.block<1, 3>(0, 0) = p.info.basis_u.transpose();
-    B.block<1, 3>(1, 0) = p.info.basis_v.transpose();
-    B(2, 3) = 1.0;
-    covariances[i] = B * full * B.transpose();
-    if (!covariances[i].allFinite()) return Error{Errc::kDegenerate, "plane marginals: not finite"};
-  }
-  return Ok();
+  return sgraph::PlaneCovariances(*m.problem, planes, covariances);
 }
 
 std::size_t SGraph::room_slots() const { return impl_->room_count; }
@@ -588,6 +556,7 @@ SGraphStats SGraph::stats() const {
   for (std::size_t i = 0; i < impl_->room_count; ++i)
     s.rooms += impl_->rooms[i].info.active ? 1u : 0u;
   s.floors = impl_->floor_active ? 1u : 0u;
+  s.retired_costs = impl_->retired_costs.size();
   s.factors = impl_->active_factors;
   return s;
 }

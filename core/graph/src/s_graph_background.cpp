@@ -9,6 +9,9 @@
 // since moves with the newest keyframe the job held (the anchor), from where the anchor is now
 // to its solution: it keeps its pose relative to the keyframe it was built on. Rooms and the
 // floor, which are re-centred by the room mapper between solves, get solved + (now - begin).
+//
+// A marginals job (BeginPlaneMarginals) takes the same copy; Run computes the planes'
+// covariances on it instead of solving and ends the job's borrowing of the graph's costs.
 #include <ceres/ceres.h>
 #include <ceres/sphere_manifold.h>
 
@@ -21,12 +24,14 @@
 
 #include "msgraphs/core/graph/s_graph.hpp"
 #include "msgraphs/core/graph/s_graph_solve_job.hpp"
+#include "s_graph_covariance.hpp"
 #include "s_graph_impl.hpp"
 
 namespace msgraphs::core {
 namespace {
 
 enum JobState : int { kIdle, kReady, kRunning, kDone };
+enum class JobKind { kFullSolve, kMarginals };
 
 // Every estimate of a graph, flat, by slot.
 struct Values {
@@ -55,7 +60,12 @@ struct SGraphSolveJob::Impl {
   std::atomic<int> state{kIdle};
   bool sized = false;
   SGraphConfig config;
+  JobKind kind = JobKind::kFullSolve;
   const void* graph = nullptr;  // the graph whose costs it borrows
+  // Its borrower slot in the graph while it borrows the graph's costs; ended once
+  // (EndBorrowing): by a marginals job's Run or Release, by a full solve's apply or drop. Only
+  // the thread that ends it touches this pointer (the claim orders Run against Release).
+  std::atomic<bool>* borrowing = nullptr;
   Values begin, solved;
   std::vector<double> stamp;  // keyframe slots are reused: a held keyframe has the same stamp
   std::vector<std::uint8_t> keyframe_in, plane_in, room_in;
@@ -68,6 +78,17 @@ struct SGraphSolveJob::Impl {
   ceres::EigenQuaternionManifold quaternion_manifold;
   ceres::SphereManifold<3> sphere_manifold;
   SGraphSolveReport report;
+  // A marginals job: the planes asked for, their blocks in `solved`, the result.
+  std::vector<std::uint32_t> marginal_ids;
+  std::vector<sgraph::PlaneBlocks> marginal_blocks;
+  std::vector<Eigen::Matrix3d> marginals;
+  bool marginals_ok = false;
+
+  void EndBorrowing() {
+    if (borrowing == nullptr) return;
+    borrowing->store(false, std::memory_order_release);  // after every use of the costs
+    borrowing = nullptr;
+  }
 
   bool Held(std::size_t k, const KeyframeNode& now) const {
     return k < keyframe_slots && keyframe_in[k] && stamp[k] == now.stamp_s;
@@ -75,7 +96,11 @@ struct SGraphSolveJob::Impl {
 };
 
 SGraphSolveJob::SGraphSolveJob() : impl_(std::make_unique<Impl>()) {}
-SGraphSolveJob::~SGraphSolveJob() = default;
+SGraphSolveJob::~SGraphSolveJob() {
+  // A job that still borrows gives its slot back (its graph must still be there; a runner must
+  // have been joined): else the graph would keep every cost it removes, and refuse Init.
+  if (impl_->state.load() != kRunning) impl_->EndBorrowing();
+}
 
 Status SGraphSolveJob::Init(const SGraphConfig& config) {
   if (auto s = config.Validate(); !s) return s;
@@ -99,6 +124,9 @@ Status SGraphSolveJob::Init(const SGraphConfig& config) {
   j.residuals.reserve(config.max_factors);
   j.ids.reserve(config.max_factors);
   j.refs.reserve(config.max_factors * 4);
+  j.marginal_ids.reserve(planes);
+  j.marginal_blocks.reserve(planes);
+  j.marginals.assign(planes, Eigen::Matrix3d::Zero());
   j.sized = true;
   return Ok();
 }
@@ -147,7 +175,11 @@ void SGraphSolveJob::Run() {
     std::size_t keyframes = 0;
     for (std::size_t k = 0; k < j.keyframe_slots; ++k) keyframes += j.keyframe_in[k];
     report.free_keyframes = keyframes > 0 ? keyframes - 1 : 0;
-    if (problem.NumResidualBlocks() == 0) {
+    if (j.kind == JobKind::kMarginals) {
+      j.marginals_ok = static_cast<bool>(sgraph::PlaneCovariances(
+          problem, j.marginal_blocks, std::span(j.marginals).first(j.marginal_blocks.size())));
+      report.usable = report.converged = j.marginals_ok;
+    } else if (problem.NumResidualBlocks() == 0) {
       report.usable = report.converged = true;
     } else {
       ceres::Solver::Summary summary;
@@ -161,6 +193,8 @@ void SGraphSolveJob::Run() {
     }
   }
   j.report = report;
+  // The problem is gone: a marginals job needs the graph's costs no more.
+  if (j.kind == JobKind::kMarginals) j.EndBorrowing();
   j.state.store(kDone, std::memory_order_release);
   j.state.notify_all();
 }
@@ -181,7 +215,67 @@ bool SGraphSolveJob::pending() const { return impl_->state.load() != kIdle; }
 bool SGraphSolveJob::done() const { return impl_->state.load() == kDone; }
 const SGraphSolveReport& SGraphSolveJob::report() const { return impl_->report; }
 
+std::span<const std::uint32_t> SGraphSolveJob::marginal_planes() const {
+  return impl_->marginal_ids;
+}
+std::span<const Eigen::Matrix3d> SGraphSolveJob::plane_marginals() const {
+  const Impl& j = *impl_;
+  if (j.kind != JobKind::kMarginals || j.state.load(std::memory_order_acquire) != kDone ||
+      !j.marginals_ok)
+    return {};
+  return std::span(j.marginals).first(j.marginal_ids.size());
+}
+
+Status SGraphSolveJob::Release() {
+  Impl& j = *impl_;
+  if (j.state.load() == kIdle) return Ok();
+  if (j.kind != JobKind::kMarginals)
+    return Error{Errc::kInvalidArgument, "a full solve is finished by its graph"};
+  if (TryClaim())
+    j.EndBorrowing();  // nobody ran it: it is not run now, its borrowing just ends
+  else
+    Complete();  // a runner has it: wait
+  j.state.store(kIdle, std::memory_order_release);
+  j.graph = nullptr;
+  return Ok();
+}
+
 Status SGraph::BeginFullSolve(SGraphSolveJob& job) {
+  Impl& m = *impl_;
+  if (m.full_job_pending) return Error{Errc::kWouldBlock, "a background solve is pending"};
+  if (auto s = CopyIntoJob(job); !s) return s;
+  SGraphSolveJob::Impl& j = *job.impl_;
+  j.kind = JobKind::kFullSolve;
+  m.full_job_pending = true;
+  j.state.store(kReady, std::memory_order_release);
+  return Ok();
+}
+
+Status SGraph::BeginPlaneMarginals(SGraphSolveJob& job, std::span<const std::uint32_t> ids) const {
+  const Impl& m = *impl_;
+  SGraphSolveJob::Impl& j = *job.impl_;
+  if (j.sized && ids.size() > j.marginals.size())
+    return Error{Errc::kCapacityExceeded, "more planes than the job holds"};
+  for (std::uint32_t id : ids) {
+    if (id >= m.plane_count || !m.planes[id].in_problem)
+      return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
+  }
+  if (auto s = CopyIntoJob(job); !s) return s;
+  j.kind = JobKind::kMarginals;
+  j.marginal_ids.clear();
+  j.marginal_blocks.clear();
+  j.marginals_ok = false;
+  for (std::uint32_t id : ids) {
+    const PlaneNode& p = m.planes[id];
+    j.marginal_ids.push_back(id);
+    j.marginal_blocks.push_back({&j.solved.pn[3 * id], &j.solved.pd[id], p.info.basis_u,
+                                 p.info.basis_v});
+  }
+  j.state.store(kReady, std::memory_order_release);
+  return Ok();
+}
+
+Status SGraph::CopyIntoJob(SGraphSolveJob& job) const {
   Impl& m = *impl_;
   SGraphSolveJob::Impl& j = *job.impl_;
   if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
@@ -189,9 +283,7 @@ Status SGraph::BeginFullSolve(SGraphSolveJob& job) {
       j.room_in.size() < m.rooms.size()) {
     return Error{Errc::kInvalidArgument, "solve job sized for a smaller graph"};
   }
-  if (m.jobs_borrowing > 0 || j.state.load() != kIdle) {
-    return Error{Errc::kWouldBlock, "a background solve is pending"};
-  }
+  if (j.state.load() != kIdle) return Error{Errc::kWouldBlock, "the job is pending"};
   j.config = m.config;  // the graph's solver limits
   Values& b = j.begin;
   j.keyframe_slots = m.keyframe_high_water;
@@ -260,16 +352,20 @@ Status SGraph::BeginFullSolve(SGraphSolveJob& job) {
     r.count = static_cast<std::uint32_t>(m.scratch_blocks.size());
     j.residuals.push_back(r);
   }
+  Impl::Borrower* borrower = m.TakeBorrower();
+  if (borrower == nullptr)
+    return Error{Errc::kWouldBlock, "too many jobs borrow from this graph"};
   j.graph = this;
-  m.jobs_borrowing = 1;
-  j.state.store(kReady, std::memory_order_release);
+  j.borrowing = &borrower->borrowing;
+  m.ReleaseRetiredCosts();  // what no job borrows any more
   return Ok();
 }
 
 Expected<double> SGraph::FactorChi2(const SGraphSolveJob& job, std::uint32_t factor) const {
   const Impl& m = *impl_;
   const SGraphSolveJob::Impl& j = *job.impl_;
-  if (j.graph != this || j.state.load(std::memory_order_acquire) != kDone)
+  if (j.graph != this || j.kind != JobKind::kFullSolve ||
+      j.state.load(std::memory_order_acquire) != kDone)
     return Error{Errc::kInvalidArgument, "solve job not done on this graph"};
   if (!j.report.usable)  // a failed solve judges nothing
     return Error{Errc::kNotConverged, "the solve job's solution is not usable"};
@@ -296,18 +392,20 @@ Expected<double> SGraph::FactorChi2(const SGraphSolveJob& job, std::uint32_t fac
 void SGraph::DropFullSolve(SGraphSolveJob& job) {
   Impl& m = *impl_;
   SGraphSolveJob::Impl& j = *job.impl_;
-  if (j.graph != this) return;
+  if (j.graph != this || j.kind != JobKind::kFullSolve) return;
   if (j.state.load() != kIdle && !job.TryClaim()) job.Complete();  // a runner has it: wait
   j.state.store(kIdle, std::memory_order_release);
   j.graph = nullptr;
-  m.jobs_borrowing = 0;
+  m.full_job_pending = false;
+  j.EndBorrowing();
   m.ReleaseRetiredCosts();
 }
 
 Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
   Impl& m = *impl_;
   SGraphSolveJob::Impl& j = *job.impl_;
-  if (j.graph != this || j.state.load(std::memory_order_acquire) != kDone)
+  if (j.graph != this || j.kind != JobKind::kFullSolve ||
+      j.state.load(std::memory_order_acquire) != kDone)
     return Error{Errc::kInvalidArgument, "solve job not done on this graph"};
   const SGraphSolveReport report = j.report;
   ++m.stats.solves;

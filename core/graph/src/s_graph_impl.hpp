@@ -8,6 +8,9 @@
 #include <ceres/sphere_manifold.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -177,10 +180,25 @@ struct SGraph::Impl {
   std::size_t factor_high_water = 0, active_factors = 0;
 
   std::vector<double> snapshot;  // parameter values before a solve, to undo a bad one
-  // Background full solve (s_graph_background.cpp): a job pending on this graph borrows its
-  // cost functions; removed ones wait in retired_costs until it is applied or dropped.
-  std::size_t jobs_borrowing = 0;
-  std::vector<const ceres::CostFunction*> retired_costs, scratch_costs;
+  // Jobs (s_graph_background.cpp) borrow the graph's cost functions: a full solve from its
+  // begin until it is applied or dropped, a marginals job until its Run ends (on its runner's
+  // thread: the flag is atomic). Each begin takes the next generation; a removed cost is kept
+  // (retired_costs, oldest first) until every job begun before its removal has ended borrowing,
+  // whatever jobs begun since still borrow.
+  struct Borrower {
+    std::atomic<bool> borrowing{false};
+    std::uint64_t generation = 0;
+  };
+  static constexpr std::size_t kMaxBorrowers = 4;
+  std::array<Borrower, kMaxBorrowers> borrowers;
+  std::uint64_t borrow_generation = 0;  // the newest begin's
+  struct RetiredCost {
+    const ceres::CostFunction* cost = nullptr;
+    std::uint64_t generation = 0;  // borrow_generation when it was removed
+  };
+  std::vector<RetiredCost> retired_costs;
+  std::vector<const ceres::CostFunction*> scratch_costs;
+  bool full_job_pending = false;  // one full solve at a time (ApplyFullSolve carries from it)
   SGraphStats stats;
 
   // The local solve's window problem (s_graph_solve.cpp): built per local solve from the
@@ -279,18 +297,45 @@ struct SGraph::Impl {
     DropFactor(slot);
   }
 
-  // The graph owns its cost functions, not the problem: a background solve (SGraphSolveJob)
-  // evaluates them on another thread, so one removed while a job borrows them is kept until the
-  // job is applied or dropped (ReleaseRetiredCosts), never deleted under it.
+  // The graph owns its cost functions, not the problem: a job (SGraphSolveJob) evaluates them
+  // on another thread, so one removed while a job begun before borrows them is kept until that
+  // job ends borrowing, never deleted under it.
   void RetireCost(const ceres::CostFunction* cost) {
-    if (jobs_borrowing > 0)
-      retired_costs.push_back(cost);  // capacity reserved at Init (a removal per factor slot)
-    else
+    if (OldestBorrower() == kNoBorrower) {
+      ReleaseRetiredCosts();
       delete cost;
+      return;
+    }
+    // Capacity reserved at Init: a removal per factor slot between two releases.
+    retired_costs.push_back({cost, borrow_generation});
+    ReleaseRetiredCosts();
   }
+  static constexpr std::uint64_t kNoBorrower = ~std::uint64_t{0};
+  // The generation of the oldest job still borrowing (kNoBorrower: none).
+  std::uint64_t OldestBorrower() const {
+    std::uint64_t oldest = kNoBorrower;
+    for (const Borrower& b : borrowers) {
+      if (b.borrowing.load(std::memory_order_acquire)) oldest = std::min(oldest, b.generation);
+    }
+    return oldest;
+  }
+  // Frees the retired costs no borrowing job can hold: those removed before the oldest
+  // borrowing job began. The runners never touch this list.
   void ReleaseRetiredCosts() {
-    for (const ceres::CostFunction* cost : retired_costs) delete cost;
-    retired_costs.clear();
+    const std::uint64_t oldest = OldestBorrower();
+    std::size_t n = 0;
+    while (n < retired_costs.size() && retired_costs[n].generation < oldest) delete retired_costs[n++].cost;
+    retired_costs.erase(retired_costs.begin(), retired_costs.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  // A slot for a job beginning now (nullptr: kMaxBorrowers jobs borrow already).
+  Borrower* TakeBorrower() {
+    for (Borrower& b : borrowers) {
+      if (b.borrowing.load(std::memory_order_acquire)) continue;
+      b.generation = ++borrow_generation;
+      b.borrowing.store(true, std::memory_order_release);
+      return &b;
+    }
+    return nullptr;
   }
   void RemoveResidual(ceres::ResidualBlockId id) {
     const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
@@ -318,7 +363,8 @@ struct SGraph::Impl {
       problem.reset();
       for (const ceres::CostFunction* cost : scratch_costs) delete cost;
     }
-    ReleaseRetiredCosts();
+    for (const RetiredCost& r : retired_costs) delete r.cost;  // no job borrows (Init, ~SGraph)
+    retired_costs.clear();
   }
 
   void EnsurePlaneInProblem(PlaneNode& p) {

@@ -273,6 +273,7 @@ bool ParseNodeConfig(const std::string& text,
   r.Number("collab", "match_period_s", 0.05, 60, c.match_period_s);
   r.Number("collab", "request_retry_s", 0.5, 600, c.request_retry_s);
   r.Bool("collab", "feedback", c.feedback);
+  r.Bool("collab", "marginals_in_background", c.marginals_in_background);
   // The merge decision's fallback (place_evidence.hpp): bytes of place clouds per peer, each way.
   double place_budget_kb = static_cast<double>(c.collab.places.budget_bytes_per_peer) / 1000.0;
   r.Number("collab", "place_budget_kb", 0, 10000, place_budget_kb);

@@ -324,6 +324,7 @@ int Node::Run(const std::atomic<bool>& stop) {
   m.threads.emplace_back([&m] { m.SlamLoop(); });
   m.threads.emplace_back([&m] { m.CollabLoop(); });
   m.threads.emplace_back([&m] { m.solver.Loop([&m] { return m.ShouldStop(); }); });
+  m.threads.emplace_back([&m] { m.marginals_solver.Loop([&m] { return m.ShouldStop(); }); });
 
   int exit_code = 0;
   const Duration telemetry_period = Duration::FromSeconds(1.0 / c.telemetry_hz);

@@ -79,6 +79,11 @@ struct SlamStatus {
   /// Exchanges not prepared because the last one was not taken yet (tried again after each scan,
   /// each try counted).
   std::uint64_t exchanges_deferred = 0;
+  /// Tries that found the exchange's wall marginals still computing on the marginals thread
+  /// (the exchange goes out at a later scan's try).
+  std::uint64_t exchanges_awaiting_marginals = 0;
+  /// From an exchange's first try to its send, while its marginals computed (wall time).
+  double marginals_wait_p50_ms = 0, marginals_wait_p99_ms = 0, marginals_wait_max_ms = 0;
   double match_p50_ms = 0, match_p99_ms = 0, match_max_ms = 0;  ///< the collab thread's Match
   // Written by the collab thread from the session (PublishCollabStatus), so that telemetry and
   // status lines never wait for a Match either.
@@ -114,6 +119,7 @@ struct Node::Impl {
   // SLAM (owned by the SLAM thread once running).
   core::LocalMapper mapper;
   SolverWorker solver;  ///< runs the mapper's full solve (its own thread)
+  SolverWorker marginals_solver;  ///< runs the distiller's wall marginals (its own thread)
   LatencyWindow keyframe_ms{4096};  ///< SLAM thread
   LatencyWindow wire_ms{4096};      ///< collab thread, under status_mutex
   std::vector<SteadyTime> unpublished_keyframes;  ///< last-packet times since the last Publish
@@ -128,6 +134,9 @@ struct Node::Impl {
   // thread (handover.hpp: while the last one still waits, the SLAM thread prepares nothing and
   // tries again after its next scan: exchanges_deferred).
   core::CollabPublisher publisher;  ///< SLAM thread only
+  bool marginals_begun = false;     ///< this exchange's first step is done (SLAM thread)
+  SteadyTime marginals_begun_at;    ///< when (SLAM thread)
+  double exchange_busy_ms = 0;      ///< the SLAM thread's time in this exchange's tries so far
   struct ExchangeSlot {
     core::CollabExchange x;
     std::vector<SteadyTime> keyframes;  ///< last-packet times of the keyframes it first carries
@@ -150,6 +159,7 @@ struct Node::Impl {
   /// Collab thread, under session_mutex: the peers' lines of SlamStatus.
   void PublishCollabStatus();
   LatencyWindow exchange_ms{4096};  ///< SLAM thread
+  LatencyWindow marginals_wait_ms{4096};  ///< SLAM thread
   LatencyWindow match_ms{4096};     ///< collab thread
   std::unique_ptr<link::FleetLink> link;
   std::unique_ptr<link::RosPublisher> ros;  ///< SLAM thread only (Exchange); set before the threads

@@ -188,11 +188,16 @@ void Node::Impl::PrintReport() {
           s.keyframe_p50_ms, s.keyframe_p99_ms, s.wire_p50_ms, s.wire_p99_ms, s.wire_max_ms,
           s.wire_samples);
   Appendf(text,
-          "  threads: SLAM thread's exchanges %.1f ms p50, %.1f ms p99, %.1f ms max (%" PRIu64
+          "  threads: SLAM thread's exchanges while mapping %.1f ms p50, %.1f ms p99, %.1f ms max (%" PRIu64
           " tries deferred: the last one not taken yet); collab thread's Match %.1f ms p50, %.1f ms "
           "p99, %.1f ms max\n",
           s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
           s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
+  Appendf(text,
+          "  exchanges held for their walls' marginals (marginals thread): %.1f ms p50, %.1f ms p99, "
+          "%.1f ms max (%" PRIu64 " tries found them computing)\n",
+          s.marginals_wait_p50_ms, s.marginals_wait_p99_ms, s.marginals_wait_max_ms,
+          s.exchanges_awaiting_marginals);
   // Read after the threads ended (the mapper is the SLAM thread's while it runs).
   const core::LocalMapperStats& ms = mapper.stats();
   Appendf(text,
@@ -200,6 +205,14 @@ void Node::Impl::PrintReport() {
           " run by the solver thread, %" PRIu64 " waited for at their keyframe; loop closures %" PRIu64 "\n",
           ms.full_solves, config.mapper.full_solve_lag_keyframes, ms.full_solves_background,
           solver.runs(), ms.full_solves_waited, ms.loop_closures);
+  const core::CollabPublisherStats& ps = publisher.stats();
+  Appendf(text,
+          "  wall marginals: %" PRIu64 " computed (%" PRIu64 " failed), %" PRIu64
+          " by the marginals thread, %" PRIu64 " at an exchange (unclaimed), %" PRIu64
+          " exchanges found them not done; walls held back for their first marginal %" PRIu64
+          " times\n",
+          ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
+          ps.marginals_run_at_prepare, ps.marginals_not_ready, ps.walls_awaiting_marginals);
   if (journal) {
     std::lock_guard<std::mutex> lock(journal_mutex);
     Appendf(text,
@@ -253,13 +266,22 @@ void Node::Impl::PrintReport() {
           static_cast<double>(usage.ru_maxrss) / 1024.0);
   Appendf(stats,
           "exchange_p50_ms %.2f\nexchange_p99_ms %.2f\nexchange_max_ms %.2f\nexchanges_deferred %" PRIu64
+          "\nexchanges_awaiting_marginals %" PRIu64 "\nmarginals_wait_p50_ms %.2f\nmarginals_wait_p99_ms %.2f"
           "\nmatch_p50_ms %.2f\nmatch_p99_ms %.2f\nmatch_max_ms %.2f\n",
           s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
+          s.exchanges_awaiting_marginals, s.marginals_wait_p50_ms, s.marginals_wait_p99_ms,
           s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
   Appendf(stats,
           "full_solves %" PRIu64 "\nfull_solves_background %" PRIu64 "\nsolver_thread_runs %" PRIu64
           "\nfull_solves_waited %" PRIu64 "\n",
-          ms.full_solves, ms.full_solves_background, solver.runs(), ms.full_solves_waited);
+          ms.full_solves, ms.full_solves_background, solver.runs(),
+          ms.full_solves_waited);
+  Appendf(stats,
+          "marginal_updates %" PRIu64 "\nmarginal_failures %" PRIu64 "\nmarginals_thread_runs %" PRIu64
+          "\nmarginals_at_exchange %" PRIu64 "\nmarginals_not_ready %" PRIu64
+          "\nwalls_awaiting_marginals %" PRIu64 "\n",
+          ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
+          ps.marginals_run_at_prepare, ps.marginals_not_ready, ps.walls_awaiting_marginals);
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
   if (!config.output_dir.empty()) {

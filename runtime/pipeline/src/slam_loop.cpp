@@ -25,10 +25,12 @@ constexpr double kOdometryMargin_s = 0.05;
 
 }  // namespace
 
-// Returns false when the last exchange still waits for the collab thread (busy in Match): then
-// nothing is prepared and the caller tries again after its next scan.
+// Returns false when the exchange cannot go out yet: its walls' marginals are still computing on
+// the marginals thread, or the last exchange still waits for the collab thread (busy in Match).
+// The caller tries again after its next scan; this thread never waits for either.
 bool Node::Impl::Exchange() {
   const SteadyTime t0 = platform::SteadyNow();
+  const auto add_busy = [&] { exchange_busy_ms += (platform::SteadyNow() - t0).seconds() * 1e3; };
   if (config.feedback) {
     bool fresh = false;
     {
@@ -50,8 +52,29 @@ bool Node::Impl::Exchange() {
       }
     }
   }
+  // Mapping: the walls' marginal covariances (a factorisation of the whole graph, over a second
+  // at 4,000 keyframes) are computed on the marginals thread, for the map as it is at the
+  // exchange's first try; the exchange goes out at the first try that finds them done, a few
+  // scans later. Once the inputs ended nothing waits on this thread: they are computed in the
+  // exchange, for the final map.
+  const bool background =
+      config.marginals_in_background && state.load() != link::NodeState::kInputDone;
+  if (background) {
+    if (!marginals_begun) {
+      if (publisher.BeginMarginals(mapper)) marginals_solver.Offer(publisher.marginals_job());
+      marginals_begun = true;
+      marginals_begun_at = t0;
+    }
+    if (!publisher.marginals_ready()) {
+      add_busy();
+      std::lock_guard<std::mutex> lock(status_mutex);
+      ++slam_status.exchanges_awaiting_marginals;
+      return false;
+    }
+  }
   ExchangeSlot* slot = exchanges.Begin();
   if (slot == nullptr) {
+    add_busy();
     std::lock_guard<std::mutex> lock(status_mutex);
     ++slam_status.exchanges_deferred;
     return false;
@@ -63,7 +86,10 @@ bool Node::Impl::Exchange() {
     for (const core::PlaceRequest& q : requests_mailbox) static_cast<void>(slot->x.requests.try_push_back(q));
     requests_mailbox.clear();
   }
-  publisher.Prepare(mapper, slot->x);
+  publisher.Prepare(mapper, slot->x,
+                    background ? core::MarginalsTiming::kBackground : core::MarginalsTiming::kNow);
+  if (background) marginals_wait_ms.Add((platform::SteadyNow() - marginals_begun_at).seconds() * 1e3);
+  marginals_begun = false;
   slot->publisher = publisher.stats();
   slot->keyframes.clear();
   slot->keyframes.insert(slot->keyframes.end(), unpublished_keyframes.begin(), unpublished_keyframes.end());
@@ -72,7 +98,11 @@ bool Node::Impl::Exchange() {
   exchanges.Post(slot);
   // The collab thread takes it between its receive rounds (at most kReceiveWait) and Matches.
   PublishRos();
-  exchange_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
+  // The SLAM thread's time in the exchange, over its tries; timed while mapping: once the
+  // inputs ended nothing waits on this thread (and the exchange computes the marginals itself).
+  add_busy();
+  if (state.load() != link::NodeState::kInputDone) exchange_ms.Add(exchange_busy_ms);
+  exchange_busy_ms = 0;
   std::lock_guard<std::mutex> lock(status_mutex);
   slam_status.walls = static_cast<std::uint32_t>(g.walls.size());
   slam_status.rooms = static_cast<std::uint32_t>(g.rooms.size());
@@ -80,6 +110,9 @@ bool Node::Impl::Exchange() {
   slam_status.exchange_p50_ms = exchange_ms.Percentile(0.5);
   slam_status.exchange_p99_ms = exchange_ms.Percentile(0.99);
   slam_status.exchange_max_ms = exchange_ms.Percentile(1.0);
+  slam_status.marginals_wait_p50_ms = marginals_wait_ms.Percentile(0.5);
+  slam_status.marginals_wait_p99_ms = marginals_wait_ms.Percentile(0.99);
+  slam_status.marginals_wait_max_ms = marginals_wait_ms.Percentile(1.0);
   return true;
 }
 

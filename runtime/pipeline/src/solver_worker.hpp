@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The mapper's full solve off the SLAM thread (LocalMapperConfig::full_solve_lag_keyframes,
-// docs/s-graph.md): the SLAM thread offers the job its mapper began after each keyframe; this
-// thread claims and runs it. Whoever claims the job first runs it, so an offer this thread
+// A job off the SLAM thread (SGraphSolveJob): the node has two of these threads, one for the
+// mapper's full solve (LocalMapperConfig::full_solve_lag_keyframes, docs/s-graph.md), offered
+// after the keyframe that began it, one for the walls' marginal covariances (Distiller,
+// MarginalsTiming::kBackground), offered after the exchange that began them, so that a long one
+// of either kind never holds up the other. This thread claims and runs what it is offered. Whoever claims the job first runs it, so an offer this thread
 // takes too late (the mapper reached the job's keyframe and ran it) is simply not claimed.
 #pragma once
 

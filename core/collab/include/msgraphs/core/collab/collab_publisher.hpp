@@ -12,8 +12,10 @@
 // in one thread: PublishNow below).
 //
 // Bounded: every store is sized at Init. Prepare allocates through Ceres only (the walls'
-// marginal covariances, Distiller); without marginals it allocates nothing (counted in
-// collab_publisher_test). A room whose cloud does not fit the exchange waits for the next one
+// marginal covariances, Distiller) when it computes them itself; with MarginalsTiming::
+// kBackground and the marginals job run by another thread (marginals_job()), or without
+// marginals, it allocates nothing (counted: collab_publisher_test without marginals,
+// distiller_test for the distillation with background marginals). A room whose cloud does not fit the exchange waits for the next one
 // (stats().rooms_deferred); a room beyond max_rooms gets no descriptor (rooms_refused).
 #pragma once
 
@@ -71,6 +73,9 @@ struct CollabExchange {
 struct CollabPublisherStats {
   std::uint64_t prepares = 0;
   std::uint64_t marginal_updates = 0, marginal_failures = 0;
+  std::uint64_t marginals_run_at_prepare = 0;   ///< kBackground: nobody had claimed the job
+  std::uint64_t marginals_not_ready = 0;        ///< kBackground: its runner was not done
+  std::uint64_t walls_awaiting_marginals = 0;   ///< summed over exchanges (Distiller::Stats)
   std::uint64_t free_space_build_failures = 0;
   std::uint64_t rooms_refused = 0, room_clouds_too_large = 0, rooms_deferred = 0;
   std::size_t room_points_peak = 0;
@@ -84,7 +89,21 @@ class CollabPublisher {
 
   /// Distils `mapper`'s graph, rebuilds the descriptors of new or significantly changed rooms,
   /// builds the free-space summary and a place cloud for each of `io.requests`, into `io`.
-  void Prepare(const LocalMapper& mapper, CollabExchange& io);
+  /// `marginals`: when the walls' marginal covariances are computed (Distiller).
+  void Prepare(const LocalMapper& mapper,
+               CollabExchange& io,
+               MarginalsTiming marginals = MarginalsTiming::kNow);
+
+  /// The first step of a kBackground Prepare (Distiller::BeginMarginals): the walls'
+  /// marginals job for the map as it is now, for marginals_job()'s runner; Prepare once
+  /// marginals_ready().
+  bool BeginMarginals(const LocalMapper& mapper) {
+    return distiller_.BeginMarginals(mapper.graph());
+  }
+  bool marginals_ready() const { return distiller_.marginals_ready(); }
+  /// The walls' marginals job BeginMarginals began, until it is done: for another thread to
+  /// take (TryClaim, then Run); nullptr otherwise.
+  SGraphSolveJob* marginals_job() { return distiller_.marginals_job(); }
 
   /// The distilled graph as last prepared.
   const DistilledGraph& graph() const { return distiller_.graph(); }
@@ -115,6 +134,7 @@ Status PublishNow(const LocalMapper& mapper,
                   CollabPublisher& publisher,
                   CollabExchange& exchange,
                   CollabSession& session,
-                  CollabOutbox& out);
+                  CollabOutbox& out,
+                  MarginalsTiming marginals = MarginalsTiming::kNow);
 
 }  // namespace msgraphs::core

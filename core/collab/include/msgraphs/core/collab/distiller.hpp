@@ -6,11 +6,27 @@
 // Versioned and incremental: each wall and room carries the graph version in which it last
 // changed by more than the resend thresholds, so the codec can send only what changed since
 // what a peer acknowledged. An Update that finds the S-Graph at the revision of the last one
-// (SGraphStats::revision) computes nothing. Its own stores are sized at
-// Init. Update allocates: with
-// `marginal_covariances` (the default) it asks the S-Graph for the walls' marginals, which
-// ceres::Covariance computes with heap memory of its own (SGraph::PlaneMarginals); without
-// them, Update allocates nothing.
+// (SGraphStats::revision) and nothing new to use computes nothing.
+//
+// The walls' marginal covariances (`marginal_covariances`, the default) come from one
+// factorisation of the whole S-Graph: 0.04 s at 300 keyframes, 1.2 s at 4,000, too long for the
+// SLAM thread at every exchange (issue 19). In the background they take two steps: at the
+// exchange, BeginMarginals copies the graph into a marginals job (SGraph::BeginPlaneMarginals:
+// a memory copy) that whoever claims it runs (marginals_job(): the node's marginals thread);
+// once marginals_ready(), Update(..., kBackground) distils with them: covariances of the graph
+// as it was at BeginMarginals, estimates as they are at the Update (a few scans later). A wall
+// that became shareable in between waits for the next exchange
+// (stats().walls_awaiting_marginals) rather than go out with its conditional covariance,
+// 1-30x smaller. An Update whose job nobody claimed runs it itself (the same result on any
+// thread); one whose job a runner has not finished never waits: it keeps the marginals it has.
+// kNow computes them in the Update for the graph as it is (the evaluation's lock-step
+// missions, a node whose inputs ended, the tests). When a computation fails (a rank-deficient
+// problem) the conditional covariances stand in for walls without a marginal.
+//
+// Memory: stores and the marginals job are sized at Init. Update allocates nothing when the
+// marginals job was run elsewhere (kBackground) or without marginals; it allocates through Ceres
+// when it computes them itself. The graph must outlive a distiller whose job is pending (the job
+// borrows its costs); a thread running the job must be done before the distiller goes.
 #pragma once
 
 #include <cstdint>
@@ -19,9 +35,13 @@
 #include "msgraphs/base/expected.hpp"
 #include "msgraphs/core/graph/distilled_graph.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "msgraphs/core/slam/plane_mapper.hpp"
 
 namespace msgraphs::core {
+
+/// When Update computes the walls' marginal covariances (see above).
+enum class MarginalsTiming { kNow, kBackground };
 
 struct DistillerConfig {
   std::uint32_t min_wall_observations = 3;  ///< walls of a room are always included
@@ -42,17 +62,39 @@ struct DistillerConfig {
 
 class Distiller {
  public:
+  Distiller() = default;
+  ~Distiller();  ///< releases a pending marginals job (its graph must still be there)
+  Distiller(const Distiller&) = delete;
+  Distiller& operator=(const Distiller&) = delete;
+
   /// `graph` gives the capacities of the S-Graph it will distil (its plane and room ids).
   Status Init(std::uint16_t robot, const SGraphConfig& graph, const DistillerConfig& config);
 
   /// Refreshes the distilled graph from the local one; true when something changed (the graph's
-  /// version then went up and the changed elements carry it).
-  bool Update(const SGraph& graph, const PlaneMapper& planes);
+  /// version then went up and the changed elements carry it). Always the same graph.
+  bool Update(const SGraph& graph,
+              const PlaneMapper& planes,
+              MarginalsTiming marginals = MarginalsTiming::kNow);
+
+  /// The first step of a kBackground Update: begins the marginals job for the walls shareable
+  /// now, unless one is pending or the graph is at the revision of the last one. True when a
+  /// job was begun.
+  bool BeginMarginals(const SGraph& graph);
+  /// Nothing is computing: the next kBackground Update has the newest marginals.
+  bool marginals_ready() const { return !job_.pending() || job_.done(); }
+  /// The marginals job BeginMarginals began, until it is done: for another thread to take
+  /// (TryClaim, then Run; a claim fails once somebody has it); nullptr otherwise.
+  SGraphSolveJob* marginals_job() { return job_.pending() && !job_.done() ? &job_ : nullptr; }
 
   const DistilledGraph& graph() const { return out_; }
   struct Stats {
     std::uint64_t marginal_updates = 0, marginal_failures = 0;
     std::uint64_t unchanged = 0;  ///< Updates that found the S-Graph as it was (nothing computed)
+    /// kBackground: marginals jobs begun; those an Update ran itself (nobody had claimed them);
+    /// Updates that found the job still running (never waited for: taken by a later Update);
+    /// walls held back, summed over Updates, because they had no marginal yet.
+    std::uint64_t marginals_begun = 0, marginals_run_at_update = 0, marginals_not_ready = 0;
+    std::uint64_t walls_awaiting_marginals = 0;
   };
   const Stats& stats() const { return stats_; }
 
@@ -63,7 +105,20 @@ class Distiller {
   std::vector<std::int32_t> room_slot_;  // local room id -> index in out_.rooms, -1 if absent
   std::vector<std::uint8_t> needed_;     // per local plane: a room uses it
   BoundedVector<std::uint32_t> eligible_;
-  std::vector<Eigen::Matrix3d> marginals_;
+  // Takes the result of the pending marginals job into marginal_ (true when it brought one).
+  bool CollectMarginals();
+  // The walls to share now, into eligible_ (and needed_).
+  void FindEligible(const SGraph& graph);
+  // Computes the marginals of eligible_ now, into marginal_.
+  void MarginalsNow(const SGraph& graph);
+
+  std::vector<Eigen::Matrix3d> marginal_;     // per local plane id: its newest marginal
+  std::vector<Eigen::Matrix3d> now_;          // kNow's, by position in eligible_
+  std::vector<std::uint8_t> marginal_known_;  // per local plane id
+  bool marginals_failed_ = false;             // the newest computation failed
+  SGraphSolveJob job_;
+  std::uint64_t job_revision_ = 0;  // the S-Graph's when the job was begun
+  bool job_begun_once_ = false;
   Stats stats_;
   bool updated_once_ = false;
   std::uint64_t revision_ = 0;  // the S-Graph's at the last Update

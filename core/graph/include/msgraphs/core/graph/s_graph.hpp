@@ -157,6 +157,9 @@ struct SGraphStats {
   std::size_t window_residuals_peak = 0;
   /// Full solves run in the background (SGraphSolveJob): applied, and refused as unusable.
   std::uint64_t background_applied = 0, background_unusable = 0;
+  /// Removed cost functions kept because a job begun before their removal may still evaluate
+  /// them (freed once every such job has ended borrowing).
+  std::size_t retired_costs = 0;
   /// Goes up at every call that may change the graph (its structure or its estimates): equal
   /// revisions, the same graph (the distiller skips its work on it).
   std::uint64_t revision = 0;
@@ -244,6 +247,13 @@ class SGraph {
   Expected<SGraphSolveReport> ApplyFullSolve(SGraphSolveJob& job);
   /// Finishes a job without applying it (after Complete, or before anybody claimed it).
   void DropFullSolve(SGraphSolveJob& job);
+  /// Copies the graph as it is now into `job` for the marginal covariances of planes `ids`
+  /// (what PlaneMarginals would give now), computed by the job's Run at the copied estimates
+  /// without solving: the distiller's marginals off the graph's thread. The graph lends its
+  /// costs until Run returns; read the job after Complete, then Release it. kWouldBlock when the
+  /// job is pending; kNotFound for a plane not in the optimisation; kCapacityExceeded beyond the
+  /// job's plane capacity. No allocation.
+  Status BeginPlaneMarginals(SGraphSolveJob& job, std::span<const std::uint32_t> ids) const;
   /// FactorChi2 at the job's solution (done jobs only): how the solve that included the factor
   /// judges it, before applying. kNotFound when the factor was not in the job or was removed;
   /// kNotConverged when the job's solution is not usable (it judges nothing).
@@ -276,6 +286,9 @@ class SGraph {
 
  private:
   struct Impl;
+  // Copies every estimate and the residual blocks into a job (BeginFullSolve,
+  // BeginPlaneMarginals); the job then borrows the graph's costs.
+  Status CopyIntoJob(SGraphSolveJob& job) const;
   std::unique_ptr<Impl> impl_;
 };
 

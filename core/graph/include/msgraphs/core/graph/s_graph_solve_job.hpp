@@ -19,15 +19,23 @@
 // otherwise waits for the worker. The result is the same with or without a worker and whatever
 // its timing: the copy is taken at a fixed point and applied at a fixed point.
 //
+// The same copy serves the walls' marginal covariances (SGraph::BeginPlaneMarginals): Run then
+// computes them at the copied estimates instead of solving, and the job lends the graph's costs
+// back as soon as Run returns; the caller reads the result after Complete and Releases the job.
+//
 // Memory: Init sizes the copy from the graph's config (allocates); BeginFullSolve and
 // ApplyFullSolve do not allocate beyond that. Run allocates (it builds a Ceres problem): it is
 // the background path. The graph must outlive a job that borrows from it, and a job must be
-// applied or dropped before its graph is re-initialised (SGraph::Init refuses) or destroyed;
-// a thread that runs a job must be joined before the job is destroyed (Run touches the job
-// after it has published "done").
+// applied, dropped or released before its graph is re-initialised (SGraph::Init refuses) or
+// destroyed; a job destroyed while it borrows gives the graph its borrower slot back (a full
+// solve's graph then still refuses the next BeginFullSolve: drop it instead). A thread that
+// runs a job must be joined before the job is destroyed (Run touches the job after it has
+// published "done"). At most four jobs borrow from one graph at once.
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
+#include <span>
 
 #include "msgraphs/base/expected.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
@@ -59,6 +67,16 @@ class SGraphSolveJob {
   bool done() const;
   /// The solve's report, once done.
   const SGraphSolveReport& report() const;
+
+  /// A marginals job (SGraph::BeginPlaneMarginals), once done: the planes asked for, in order,
+  /// and each one's covariance over (alpha, beta, delta_d) along its basis_u / basis_v. Empty
+  /// covariances when the computation failed (a rank-deficient problem).
+  std::span<const std::uint32_t> marginal_planes() const;
+  std::span<const Eigen::Matrix3d> plane_marginals() const;
+  /// A marginals job back to idle (its results go): one nobody claimed is not run, one running
+  /// is waited for. A full solve is finished by its graph instead (ApplyFullSolve,
+  /// DropFullSolve): kInvalidArgument.
+  Status Release();
 
  private:
   friend class SGraph;
