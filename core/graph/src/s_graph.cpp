@@ -48,6 +48,7 @@ Status SGraph::Init(const SGraphConfig& config) {
   Impl& m = *impl_;
   if (m.OldestBorrower() != Impl::kNoBorrower)  // it would free the costs a job evaluates
     return Error{Errc::kWouldBlock, "a background solve job borrows from this graph"};
+  m.full_job_pending = false;  // a full solve destroyed unfinished gave its slot back
   m.config = config;
   ceres::Problem::Options options;
   // The graph owns the costs (RetireCost): a background solve may still be evaluating one the

@@ -135,7 +135,8 @@ struct Node::Impl {
   // tries again after its next scan: exchanges_deferred).
   core::CollabPublisher publisher;  ///< SLAM thread only
   bool marginals_begun = false;     ///< this exchange's first step is done (SLAM thread)
-  SteadyTime marginals_begun_at;    ///< when (SLAM thread)
+  bool marginals_job_begun = false; ///< ... and began a marginals job (SLAM thread)
+  SteadyTime marginals_begun_at, marginals_done_at;  ///< first try, first try that found it done
   double exchange_busy_ms = 0;      ///< the SLAM thread's time in this exchange's tries so far
   struct ExchangeSlot {
     core::CollabExchange x;

@@ -208,11 +208,10 @@ void Node::Impl::PrintReport() {
   const core::CollabPublisherStats& ps = publisher.stats();
   Appendf(text,
           "  wall marginals: %" PRIu64 " computed (%" PRIu64 " failed), %" PRIu64
-          " by the marginals thread, %" PRIu64 " at an exchange (unclaimed), %" PRIu64
-          " exchanges found them not done; walls held back for their first marginal %" PRIu64
-          " times\n",
+          " by the marginals thread; walls held back to the next exchange (shareable only after "
+          "the copy) %" PRIu64 " times\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
-          ps.marginals_run_at_prepare, ps.marginals_not_ready, ps.walls_awaiting_marginals);
+          ps.walls_awaiting_marginals);
   if (journal) {
     std::lock_guard<std::mutex> lock(journal_mutex);
     Appendf(text,
@@ -267,10 +266,11 @@ void Node::Impl::PrintReport() {
   Appendf(stats,
           "exchange_p50_ms %.2f\nexchange_p99_ms %.2f\nexchange_max_ms %.2f\nexchanges_deferred %" PRIu64
           "\nexchanges_awaiting_marginals %" PRIu64 "\nmarginals_wait_p50_ms %.2f\nmarginals_wait_p99_ms %.2f"
+          "\nmarginals_wait_max_ms %.2f"
           "\nmatch_p50_ms %.2f\nmatch_p99_ms %.2f\nmatch_max_ms %.2f\n",
           s.exchange_p50_ms, s.exchange_p99_ms, s.exchange_max_ms, s.exchanges_deferred,
           s.exchanges_awaiting_marginals, s.marginals_wait_p50_ms, s.marginals_wait_p99_ms,
-          s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
+          s.marginals_wait_max_ms, s.match_p50_ms, s.match_p99_ms, s.match_max_ms);
   Appendf(stats,
           "full_solves %" PRIu64 "\nfull_solves_background %" PRIu64 "\nsolver_thread_runs %" PRIu64
           "\nfull_solves_waited %" PRIu64 "\n",
@@ -278,10 +278,9 @@ void Node::Impl::PrintReport() {
           ms.full_solves_waited);
   Appendf(stats,
           "marginal_updates %" PRIu64 "\nmarginal_failures %" PRIu64 "\nmarginals_thread_runs %" PRIu64
-          "\nmarginals_at_exchange %" PRIu64 "\nmarginals_not_ready %" PRIu64
           "\nwalls_awaiting_marginals %" PRIu64 "\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
-          ps.marginals_run_at_prepare, ps.marginals_not_ready, ps.walls_awaiting_marginals);
+          ps.walls_awaiting_marginals);
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
   if (!config.output_dir.empty()) {

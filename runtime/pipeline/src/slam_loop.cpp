@@ -61,11 +61,14 @@ bool Node::Impl::Exchange() {
       config.marginals_in_background && state.load() != link::NodeState::kInputDone;
   if (background) {
     if (!marginals_begun) {
-      if (publisher.BeginMarginals(mapper)) marginals_solver.Offer(publisher.marginals_job());
+      marginals_job_begun = publisher.BeginMarginals(mapper);
+      if (marginals_job_begun) marginals_solver.Offer(publisher.marginals_job());
       marginals_begun = true;
       marginals_begun_at = t0;
     }
-    if (!publisher.marginals_ready()) {
+    if (publisher.marginals_ready()) {
+      if (marginals_job_begun && marginals_done_at < marginals_begun_at) marginals_done_at = t0;
+    } else {
       add_busy();
       std::lock_guard<std::mutex> lock(status_mutex);
       ++slam_status.exchanges_awaiting_marginals;
@@ -88,7 +91,9 @@ bool Node::Impl::Exchange() {
   }
   publisher.Prepare(mapper, slot->x,
                     background ? core::MarginalsTiming::kBackground : core::MarginalsTiming::kNow);
-  if (background) marginals_wait_ms.Add((platform::SteadyNow() - marginals_begun_at).seconds() * 1e3);
+  // From the first try to the first that found the job done (a wait for a free slot after it
+  // is exchanges_deferred's).
+  if (background && marginals_job_begun) marginals_wait_ms.Add((marginals_done_at - marginals_begun_at).seconds() * 1e3);
   marginals_begun = false;
   slot->publisher = publisher.stats();
   slot->keyframes.clear();
@@ -223,6 +228,9 @@ void Node::Impl::SlamLoop() {
     if (scan == nullptr) {
       drain_odometry(lockstep() ? -inf : inf);
       if (scans.closed()) break;  // the LiDAR input ended (or failed)
+      // A LiDAR that stalls must not hold an owed exchange (its marginals done meanwhile) or a
+      // peer's resync: tried again every kWait.
+      if (exchange_owed || publish_now.exchange(false)) exchange_owed = !Exchange();
       continue;
     }
     const double needed_s = scan->end_s + kOdometryMargin_s;

@@ -9,7 +9,7 @@
 // (SGraphStats::revision) and nothing new to use computes nothing.
 //
 // The walls' marginal covariances (`marginal_covariances`, the default) come from one
-// factorisation of the whole S-Graph: 0.04 s at 300 keyframes, 1.2 s at 4,000, too long for the
+// factorisation of the whole S-Graph: 0.045 s at 300 keyframes, 1.04 s at 4,000 (p50), too long for the
 // SLAM thread at every exchange (issue 19). In the background they take two steps: at the
 // exchange, BeginMarginals copies the graph into a marginals job (SGraph::BeginPlaneMarginals:
 // a memory copy) that whoever claims it runs (marginals_job(): the node's marginals thread);

@@ -61,9 +61,10 @@ struct NodeConfig {
   double match_period_s = 0.5;
   double request_retry_s = 10.0;
   bool feedback = true;  ///< other robots' walls into the local S-Graph
-  /// The walls' marginal covariances on the solver thread, sent one exchange late (true), or
-  /// computed in the exchange on the SLAM thread (false: fresh, but a factorisation of the
-  /// whole graph there, over a second at 4,000 keyframes). docs/multi-robot.md.
+  /// The walls' marginal covariances computed on the marginals thread, the exchange sent once
+  /// they are done (true), or computed in the exchange on the SLAM thread (false: a
+  /// factorisation of the whole graph there, about a second at 4,000 keyframes).
+  /// docs/multi-robot.md, "Wall covariance".
   bool marginals_in_background = true;
 
   // [link]
