@@ -61,6 +61,10 @@ else
   echo "PCL not found at configure time: merged_map.pcd checked by its header only"
   [[ $declared -gt 10000 ]] || { echo "too few points"; rc=1; }
 fi
-if [[ $rc -ne 0 ]]; then tail -n 30 "$work"/demo/logs/robot1.log; fi
+if [[ $rc -ne 0 ]]; then
+  tail -n 30 "$work"/demo/logs/robot1.log
+  # Why a robot did not merge: every decision its session logged.
+  for k in 1 2; do echo "robot $k merge_log.csv:"; cat "$out/nodes/robot$k/merge_log.csv" 2>/dev/null; done
+fi
 [[ $rc -eq 0 ]] && echo "PASS: demo outputs" || echo FAIL
 exit $rc

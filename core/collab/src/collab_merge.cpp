@@ -138,6 +138,7 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
   // wall, while the 11.6 m of cross wall that fixed the slide (two rooms' walls coinciding by
   // chance) stayed the same, and the true transform, the same corridor with nothing across,
   // stood beside it unrefuted.
+  bool leader_replaced = false;
   if (d.verdict == MergeVerdict::kMerge && !d.keeping) {
     const bool newer = own_version != p.pending_own || p.graph.version != p.pending_peer;
     const double constraint_m = d.leader.agreement.constraint_m;
@@ -147,6 +148,9 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
         p.pending_constraint_m = constraint_m;
       }
     } else {
+      // Another leader than the one awaiting confirmation: logged even when the verdict stays
+      // "awaits confirmation", so that a merge log shows why a leader was never confirmed.
+      leader_replaced = p.pending_count > 0;
       p.pending_count = 1;
       p.pending_constraint_m = constraint_m;
     }
@@ -191,7 +195,7 @@ bool CollabSession::Impl::DecidePeer(Peer& p) {
     ++stats.undone;
     Log(p, MergeEvent::kUndone);
     changed = true;
-  } else if (before != d.verdict || !p.logged) {
+  } else if (before != d.verdict || !p.logged || leader_replaced) {
     Log(p, MergeEvent::kUndecided);
   }
   p.logged = true;
