@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-// The local S-Graph front end: odometry buffer, keyframe cloud store, plane association, the
+// The local S-Graph front end: odometry buffer, plane association, the
 // Hessian-shaped information, and the whole mapper on a synthetic room walked with biased
-// odometry, also for laps on end with a keyframe store a third of the walk (loops everywhere);
+// odometry, also for laps on end with a keyframe store a third of the walk (loops everywhere)
+// and with a cloud store that must keep a cloud of every place;
 // bad input counted; no allocation on the per-scan path.
 #include <gtest/gtest.h>
 
@@ -10,13 +11,13 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "alloc_counter.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
-#include "msgraphs/core/slam/keyframe_cloud_store.hpp"
 #include "msgraphs/core/slam/local_mapper.hpp"
 #include "msgraphs/core/slam/loop_closer.hpp"
 #include "msgraphs/core/slam/odometry_buffer.hpp"
@@ -54,42 +55,6 @@ TEST(OdometryBuffer, InterpolatesAndRefusesDisorder) {
   EXPECT_EQ(b.size(), 8u);
   EXPECT_EQ(b.stats().overwritten, 5u);
   EXPECT_EQ(b.At(1.05).error().code, Errc::kNotFound);
-}
-
-TEST(KeyframeCloudStore, EvictsTheOldestAndTellsReusedKeysApart) {
-  KeyframeCloudStore s;
-  s.Init(4, 100);
-  const std::vector<Eigen::Vector3f> forty(40, Eigen::Vector3f(1, 2, 3));
-  ASSERT_TRUE(s.Put(0, 1, forty));
-  ASSERT_TRUE(s.Put(1, 2, forty));
-  EXPECT_EQ(s.Get(0, 1).size(), 40u);
-  EXPECT_TRUE(s.Get(0, 7).empty());  // another owner of key 0
-  ASSERT_TRUE(s.Put(2, 3, forty));   // wraps: evicts key 0 only
-  EXPECT_TRUE(s.Get(0, 1).empty());
-  EXPECT_EQ(s.Get(1, 2).size(), 40u);
-  EXPECT_EQ(s.Get(2, 3).size(), 40u);
-  EXPECT_EQ(s.evicted(), 1u);
-  EXPECT_LE(s.used_points(), 100u);
-  EXPECT_EQ(s.peak_points(), 80u);
-  const std::vector<Eigen::Vector3f> huge(101, Eigen::Vector3f::Zero());
-  EXPECT_EQ(s.Put(3, 4, huge).error().code, Errc::kCapacityExceeded);
-  EXPECT_EQ(s.Put(9, 4, forty).error().code, Errc::kInvalidArgument);
-}
-
-TEST(KeyframeCloudStore, PuttingAndGettingAllocateNothingAfterInit) {
-  KeyframeCloudStore s;
-  s.Init(8, 1000);
-  const std::vector<Eigen::Vector3f> cloud(150, Eigen::Vector3f(1, 2, 3));
-  std::size_t found = 0;
-  test::AllocationScope scope;
-  // 200 keyframes through 8 keys and room for 6 clouds: keys reused, the oldest evicted.
-  for (std::uint32_t k = 0; k < 200; ++k) {
-    ASSERT_TRUE(s.Put(k % 8, k + 1, cloud));
-    found += s.Get(k % 8, k + 1).size();
-  }
-  EXPECT_EQ(scope.allocations(), 0u);
-  EXPECT_EQ(found, 200u * 150u);
-  EXPECT_GT(s.evicted(), 150u);
 }
 
 ExtractedPlane Wall(const Eigen::Vector3d& n, double d, double u_min, double u_max) {
@@ -270,6 +235,16 @@ LocalMapperConfig SmallConfig(std::size_t keyframes, int grid_cells) {
   config.grid.origin_m = Eigen::Vector2f(5.0f, 4.0f) -
                          Eigen::Vector2f::Constant(0.05f * static_cast<float>(grid_cells));
   return config;
+}
+
+// Step i of a walk (one keyframe a second): its odometry around the sweep, then the sweep.
+auto FeedStep(LocalMapper& mapper, const LocalMapperConfig& config, const Walk& walk, std::size_t i,
+              std::span<const float> times) {
+  const double t = 10.0 + static_cast<double>(i);
+  EXPECT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
+  EXPECT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
+  const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
+  return mapper.AddScan({points, times, t - 0.1, t});
 }
 
 TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
@@ -632,11 +607,7 @@ TEST(LocalMapper, PatrolWithLoopsEverywhereStaysWithinTheGraphsCapacity) {
   const Walk walk(60);
   std::vector<float> times(20000, 0.1f);
   for (std::size_t i = 0; i < walk.truth.size(); ++i) {
-    const double t = 10.0 + static_cast<double>(i);
-    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
-    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
-    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
-    auto outcome = mapper.AddScan({points, times, t - 0.1, t});
+    auto outcome = FeedStep(mapper, config, walk, i, times);
     ASSERT_TRUE(outcome) << "keyframe " << i << ": " << outcome.error().detail;
     ASSERT_EQ(*outcome, ScanOutcome::kKeyframe);
     ASSERT_LE(mapper.graph().keyframe_slots(), config.graph.max_keyframes + 1);
@@ -691,11 +662,7 @@ PatrolResult Patrol(std::size_t lag, bool worker) {
   std::jthread runner;
   std::uint64_t begun = 0;
   for (std::size_t i = 0; i < walk.truth.size(); ++i) {
-    const double t = 10.0 + static_cast<double>(i);
-    EXPECT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
-    EXPECT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
-    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
-    EXPECT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
+    EXPECT_TRUE(FeedStep(mapper, config, walk, i, times));
     // One thread per job begun, as the node's solver thread takes each offer once; the previous
     // job was applied before this one began, so its thread has finished.
     if (worker && mapper.stats().full_solves_begun != begun) {
@@ -739,6 +706,46 @@ TEST(LocalMapper, TheFullSolveInTheBackgroundMakesTheSameMap) {
     EXPECT_LT((background.positions[k] - no_worker.positions[k]).norm(), 1e-6) << k;
     EXPECT_LT((background.positions[k] - on_the_spot.positions[k]).norm(), 0.02) << k;
   }
+}
+
+// Three laps of 15 places with a cloud store of about 15 clouds: a place's older clouds go,
+// every place keeps one (the ring the store replaced kept the last N keyframes' instead).
+TEST(LocalMapper, AFullCloudStoreKeepsACloudOfEveryPlace) {
+  LocalMapperConfig config = SmallConfig(64, 256);
+  config.cloud_store_points = 100000;
+  LocalMapper mapper;
+  ASSERT_TRUE(mapper.Init(config));
+  const Walk walk(45);
+  std::vector<float> times(20000, 0.1f);
+  for (std::size_t i = 0; i < walk.truth.size(); ++i) ASSERT_TRUE(FeedStep(mapper, config, walk, i, times));
+  ASSERT_TRUE(mapper.Finish());
+  const KeyframeCloudStoreStats& st = mapper.clouds().stats();
+  const double cell_m = mapper.cloud_cover().cell_m();
+  const SGraph& g = mapper.graph();
+  std::printf("store: %zu clouds of %zu keyframes, %zu points (%zu capacity); evicted %llu covered, %llu uncovered; "
+              "cell %.1f m, %llu coarsenings, %llu compactions\n",
+              mapper.clouds().stored_clouds(), static_cast<std::size_t>(g.stats().keyframes),
+              mapper.clouds().used_points(), mapper.clouds().capacity_points(),
+              static_cast<unsigned long long>(st.evicted_covered),
+              static_cast<unsigned long long>(st.evicted_uncovered), cell_m,
+              static_cast<unsigned long long>(mapper.cloud_cover().coarsenings()),
+              static_cast<unsigned long long>(st.compactions));
+  EXPECT_GT(st.evicted_covered, 0u);
+  EXPECT_EQ(st.evicted_uncovered, 0u);
+  EXPECT_LT(mapper.clouds().stored_clouds(), walk.truth.size());
+  // Every place of the walk has a stored cloud taken within a cell of it.
+  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
+    double nearest = 1e9;
+    for (std::uint32_t k = 0; k < g.keyframe_slots(); ++k) {
+      if (mapper.keyframe_cloud(k).empty()) continue;
+      nearest = std::min(nearest, (g.keyframe_pose(k).translation() - walk.truth[i].translation()).norm());
+    }
+    EXPECT_LE(nearest, std::sqrt(3.0) * cell_m) << "place " << i;
+  }
+  // The local map's keyframes are never evicted.
+  std::vector<std::uint32_t> recent(config.local_map_keyframes);
+  const std::size_t n = g.RecentKeyframes(recent);
+  for (std::size_t j = 0; j < n; ++j) EXPECT_FALSE(mapper.keyframe_cloud(recent[j]).empty()) << recent[j];
 }
 
 TEST(LocalMapper, BadScansAreCountedAndTheScanPathDoesNotAllocate) {

@@ -5,65 +5,132 @@
 
 namespace msgraphs::core {
 
-void KeyframeCloudStore::Init(std::size_t max_keys, std::size_t max_points) {
+void KeyframeCloudStore::Init(std::size_t max_keys, std::size_t max_points, std::size_t reclaim_points) {
   points_.assign(max_points, Eigen::Vector3f::Zero());
   entries_.assign(max_keys, Entry{});
-  // Every Put adds one order entry; stale ones (replaced keys) are skipped when evicted. A key
-  // count's worth of live entries plus as many stale ones bounds the ring.
+  // Every Put appends one order entry; stale ones (keys replaced or evicted) are dropped by the
+  // next compaction, which runs when the order is full: a key count's worth of live entries
+  // plus as many stale ones bounds it.
   order_.assign(2 * max_keys + 1, 0);
-  order_sequence_.assign(order_.size(), 0);
-  order_head_ = order_size_ = write_ = used_ = peak_ = 0;
-  evicted_ = 0;
+  order_stamp_.assign(order_.size(), 0);
+  order_size_ = top_ = used_ = peak_ = live_ = 0;
+  reclaim_ = std::min(reclaim_points, max_points);
+  stamp_ = 0;
+  stats_ = {};
 }
 
-void KeyframeCloudStore::EvictFront() {
-  const std::uint32_t key = order_[order_head_];
-  const std::uint64_t sequence = order_sequence_[order_head_];
-  order_head_ = (order_head_ + 1) % order_.size();
-  --order_size_;
+bool KeyframeCloudStore::Live(std::size_t i) const {
+  const Entry& e = entries_[order_[i]];
+  return e.valid && e.stamp == order_stamp_[i];
+}
+
+void KeyframeCloudStore::Evict(std::uint32_t key, const CloudRetentionPolicy* policy, CloudRetention why) {
   Entry& e = entries_[key];
-  if (e.valid && e.sequence == sequence) {
-    e.valid = false;
-    used_ -= e.count;
-    ++evicted_;
+  e.valid = false;
+  used_ -= e.count;
+  --live_;
+  ++stats_.evicted;
+  if (policy == nullptr) return;
+  if (why == CloudRetention::kGone) {
+    ++stats_.evicted_gone;
+  } else if (why == CloudRetention::kUnique) {
+    ++stats_.evicted_uncovered;
+  } else {
+    ++stats_.evicted_covered;
   }
+}
+
+template <typename Take>
+void KeyframeCloudStore::EvictPass(std::size_t goal, CloudRetentionPolicy* policy, Take take) {
+  if (policy != nullptr) policy->BeginPass();
+  for (std::size_t i = 0; i < order_size_ && points_.size() - used_ < goal; ++i) {
+    if (!Live(i)) continue;
+    const std::uint32_t key = order_[i];
+    const CloudRetention why =
+        policy != nullptr ? policy->Retention(key, entries_[key].sequence) : CloudRetention::kReplaceable;
+    if (take(why)) Evict(key, policy, why);
+  }
+}
+
+void KeyframeCloudStore::MakeRoom(std::size_t need, CloudRetentionPolicy* policy) {
+  const std::size_t target = std::max(need, reclaim_);
+  const auto free_points = [this]() { return points_.size() - used_; };
+  for (;;) {
+    if (free_points() >= target) break;
+    // Clouds nothing needs first, then the older clouds of the places the robot is at now.
+    EvictPass(target, policy, [](CloudRetention why) {
+      return why == CloudRetention::kGone || why == CloudRetention::kReplaceable;
+    });
+    if (policy == nullptr || free_points() >= target) break;
+    EvictPass(target, policy, [](CloudRetention why) { return why == CloudRetention::kRevisited; });
+    if (free_points() >= target || !policy->Coarsen()) break;
+  }
+  // Still short of what the new cloud needs: unique clouds go, oldest first, never pinned ones.
+  if (free_points() < need && policy != nullptr) {
+    EvictPass(need, policy, [](CloudRetention why) { return why != CloudRetention::kPinned; });
+  }
+  Compact();
+}
+
+void KeyframeCloudStore::Compact() {
+  // Order is address order (appended at the top, kept by every compaction), so each live cloud
+  // moves down or stays: a forward copy never overwrites what it has still to read.
+  std::size_t write = 0, kept = 0;
+  for (std::size_t i = 0; i < order_size_; ++i) {
+    if (!Live(i)) continue;
+    Entry& e = entries_[order_[i]];
+    if (e.offset != write) {
+      const auto from = points_.begin() + static_cast<std::ptrdiff_t>(e.offset);
+      std::copy(from, from + static_cast<std::ptrdiff_t>(e.count),
+                points_.begin() + static_cast<std::ptrdiff_t>(write));
+      e.offset = write;
+    }
+    write += e.count;
+    order_[kept] = order_[i];
+    order_stamp_[kept] = order_stamp_[i];
+    ++kept;
+  }
+  order_size_ = kept;
+  top_ = write;
+  ++stats_.compactions;
 }
 
 Status KeyframeCloudStore::Put(std::uint32_t key,
                                std::uint64_t sequence,
-                               std::span<const Eigen::Vector3f> points) {
+                               std::span<const Eigen::Vector3f> points,
+                               CloudRetentionPolicy* policy) {
   if (key >= entries_.size())
     return Error{Errc::kInvalidArgument, "keyframe cloud key beyond capacity"};
-  if (points.size() > points_.size())
+  if (points.size() > points_.size()) {
+    ++stats_.refused;
     return Error{Errc::kCapacityExceeded, "keyframe cloud larger than the store"};
+  }
   Entry& old = entries_[key];
-  if (old.valid) {
-    used_ -= old.count;
+  if (old.valid) {  // replaced: its points are freed by the next compaction
     old.valid = false;
+    used_ -= old.count;
+    --live_;
   }
-  if (write_ + points.size() > points_.size()) write_ = 0;  // wrap; the tail stays unused
-  const std::size_t begin = write_, end = write_ + points.size();
-  // Evict, oldest first, every cloud overlapping [begin, end).
-  while (order_size_ > 0) {
-    const Entry& front = entries_[order_[order_head_]];
-    const bool stale = !front.valid || front.sequence != order_sequence_[order_head_];
-    const bool overlaps = front.offset < end && begin < front.offset + front.count;
-    if (!stale && !overlaps) break;
-    EvictFront();
+  if (top_ + points.size() > points_.size() || order_size_ == order_.size()) {
+    MakeRoom(points.size(), policy);
+    if (top_ + points.size() > points_.size()) {
+      ++stats_.refused;
+      return Error{Errc::kCapacityExceeded, "keyframe cloud store holds only pinned clouds"};
+    }
   }
-  if (order_size_ == order_.size()) EvictFront();
-  std::copy(points.begin(), points.end(), points_.begin() + static_cast<std::ptrdiff_t>(begin));
+  std::copy(points.begin(), points.end(), points_.begin() + static_cast<std::ptrdiff_t>(top_));
   Entry& e = entries_[key];
-  e.offset = begin;
+  e.offset = top_;
   e.count = points.size();
   e.sequence = sequence;
+  e.stamp = ++stamp_;
   e.valid = true;
-  const std::size_t tail = (order_head_ + order_size_) % order_.size();
-  order_[tail] = key;
-  order_sequence_[tail] = sequence;
+  order_[order_size_] = key;
+  order_stamp_[order_size_] = e.stamp;
   ++order_size_;
-  write_ = end;
+  top_ += points.size();
   used_ += points.size();
+  ++live_;
   peak_ = std::max(peak_, used_);
   return Ok();
 }

@@ -95,7 +95,11 @@ Status LocalMapper::Init(const LocalMapperConfig& config) {
   if (auto s = fitness_gate_.Init(config.scan_match_fitness_gate()); !s) return s;
   odometry_.Init(config.odometry_capacity, config.odometry_max_gap_s);
   const std::size_t slots = config.graph.max_keyframes + 1;
-  clouds_.Init(slots, config.cloud_store_points);
+  // A full store makes room for a sixteenth of itself at a time: the slide that follows (one
+  // memmove of what is stored) is then paid once per that many points, about 15 keyframes at
+  // the default size, not at every keyframe.
+  clouds_.Init(slots, config.cloud_store_points, config.cloud_store_points / 16);
+  cover_.Init(slots, config.local_map_keyframes, config.keyframe_spacing_m, config.max_range_m);
   PlaneAssociationConfig association = config.association;
   association.sensor_height_m = config.T_base_lidar.translation().z();  // keyframes are base frames
   if (auto s = planes_mapper_.Init(config.graph.max_planes, association); !s) return s;
@@ -410,7 +414,8 @@ Expected<ScanOutcome> LocalMapper::AddScanImpl(const LidarScanView& scan, StageO
   Stage(observer, MapperStage::kPlanes);
   // Stored cloud and descriptor.
   if (scan_voxel_.Downsample(down_.span(), config_.store_voxel_m, stored_)) {
-    static_cast<void>(clouds_.Put(id, sequence_[id], stored_.span()));
+    cover_.Bind(clouds_, graph_, sequence_, id);  // bound here: a mapper may be moved after Init
+    static_cast<void>(clouds_.Put(id, sequence_[id], stored_.span(), &cover_));
     static_cast<void>(loops_.AddKeyframe(id, sequence_[id], path_m_, stored_.span()));
   }
   // Free space from the full-resolution sweep, with the estimate as it is now.

@@ -104,6 +104,12 @@ bool LoopCloser::DetectImpl(SGraph& graph,
     }
     const auto match = ScanContextDistance(latest_, candidate_);
     if (!match || match->distance > config_.max_scan_context_distance) continue;
+    // Evicted from the full cloud store (its place keeps another cloud): counted, and never
+    // given one of the max_verifications.
+    if (cloud_of(ctx, k, e.sequence).empty()) {
+      ++stats_.cloud_evicted;
+      continue;
+    }
     candidates_.emplace_back(match->distance, k);
   }
   if (candidates_.empty()) return false;

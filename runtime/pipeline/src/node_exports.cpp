@@ -95,11 +95,21 @@ void Node::Impl::WriteExports() {
   if (auto s = WritePcd((dir / "map.pcd").string(), map_points); !s) {
     std::fprintf(stderr, "msgraphs_node: cannot write map.pcd: %s\n", s.error().detail);
   }
+  // The bounded store keeps a cloud of every place (a cell of cloud_cover().cell_m()), so a
+  // keyframe without one is normally covered by another cloud of its place.
+  const core::KeyframeCloudStoreStats& store = mapper.clouds().stats();
   if (keyframes_without_cloud > 0) {
     std::fprintf(stderr,
-                 "msgraphs_node: map.pcd lacks %zu keyframes whose clouds the bounded store had "
-                 "evicted\n",
-                 keyframes_without_cloud);
+                 "msgraphs_node: map.pcd: %zu keyframes have no stored cloud (the store keeps one "
+                 "per place, cells of %.1f m)\n",
+                 keyframes_without_cloud, mapper.cloud_cover().cell_m());
+  }
+  if (store.evicted_uncovered > 0) {
+    std::fprintf(stderr,
+                 "msgraphs_node: WARNING: the cloud store evicted %llu clouds that were their "
+                 "place's only one ([mapping] cloud_store_points too small for the building): "
+                 "map.pcd may have holes there\n",
+                 static_cast<unsigned long long>(store.evicted_uncovered));
   }
 
   // ---- the collaborative graph ----

@@ -212,6 +212,15 @@ void Node::Impl::PrintReport() {
           "the copy) %" PRIu64 " times\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
           ps.walls_awaiting_marginals);
+  const core::KeyframeCloudStore& store = mapper.clouds();
+  const core::KeyframeCloudStoreStats& store_stats = store.stats();
+  Appendf(text,
+          "  keyframe clouds: %zu stored (%.1f of %.1f M points), places of %.1f m; evicted %" PRIu64
+          " whose place kept another cloud, %" PRIu64 " of sparsified keyframes, %" PRIu64
+          " that were their place's only one\n",
+          store.stored_clouds(), static_cast<double>(store.used_points()) / 1e6,
+          static_cast<double>(store.capacity_points()) / 1e6, mapper.cloud_cover().cell_m(),
+          store_stats.evicted_covered, store_stats.evicted_gone, store_stats.evicted_uncovered);
   if (journal) {
     std::lock_guard<std::mutex> lock(journal_mutex);
     Appendf(text,
@@ -281,6 +290,11 @@ void Node::Impl::PrintReport() {
           "\nwalls_awaiting_marginals %" PRIu64 "\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
           ps.walls_awaiting_marginals);
+  Appendf(stats,
+          "cloud_store_clouds %zu\ncloud_store_evicted_covered %" PRIu64 "\ncloud_store_evicted_uncovered %" PRIu64
+          "\ncloud_cover_cell_m %.2f\n",
+          store.stored_clouds(), store_stats.evicted_covered, store_stats.evicted_uncovered,
+          mapper.cloud_cover().cell_m());
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
   if (!config.output_dir.empty()) {

@@ -42,6 +42,7 @@
 #include "msgraphs/core/perception/voxel_grid.hpp"
 #include "msgraphs/core/registration/gaussian_voxel_map.hpp"
 #include "msgraphs/core/registration/vgicp.hpp"
+#include "msgraphs/core/slam/cloud_cover_policy.hpp"
 #include "msgraphs/core/slam/keyframe_cloud_store.hpp"
 #include "msgraphs/core/slam/loop_closer.hpp"
 #include "msgraphs/core/slam/fitness_gate.hpp"
@@ -139,6 +140,8 @@ struct LocalMapperConfig {
   /// judgement, and its keyframes must not be sparsified meanwhile.
   std::size_t full_solve_lag_keyframes = 5;
   std::size_t max_plane_priors = 256;  ///< external wall priors held at once (SetPlanePriors)
+  /// The keyframe cloud store (12 bytes a point). Full, it evicts a place's older clouds first
+  /// and makes places coarser before one loses its only cloud (CloudCoverPolicy).
   std::size_t cloud_store_points = 1500000;
   std::size_t odometry_capacity = 4096;
   double odometry_max_gap_s = 0.1;
@@ -357,6 +360,8 @@ class LocalMapper {
   const LoopCloser& loop_closer() const { return loops_; }
   const OdometryBuffer& odometry() const { return odometry_; }
   const KeyframeCloudStore& clouds() const { return clouds_; }
+  /// The store's places: cell size now and how often it was doubled to make room.
+  const CloudCoverPolicy& cloud_cover() const { return cover_; }
   /// A keyframe's stored cloud (base frame, store_voxel_m); empty when evicted or sparsified.
   std::span<const Eigen::Vector3f> keyframe_cloud(std::uint32_t keyframe) const {
     if (keyframe >= sequence_.size() || !graph_.keyframe_active(keyframe)) return {};
@@ -414,6 +419,7 @@ class LocalMapper {
   SGraph graph_;
   OdometryBuffer odometry_;
   KeyframeCloudStore clouds_;
+  CloudCoverPolicy cover_;  ///< what a full cloud store evicts: a place's older clouds first
   PlaneMapper planes_mapper_;
   RoomMapper rooms_;
   LoopCloser loops_;
