@@ -35,7 +35,7 @@ Status Distiller::Init(std::uint16_t robot,
   now_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
   marginal_known_.assign(graph.max_planes, 0);
   marginals_failed_ = false;
-  job_begun_once_ = false;
+  job_revision_.reset();
   stats_ = {};
   updated_once_ = false;
   return Ok();
@@ -53,21 +53,24 @@ bool Distiller::CollectMarginals() {
     job_.Run();  // nobody took it: the same result, on this thread
     ++stats_.marginals_run_at_update;
   }
-  const auto ids = job_.marginal_planes();
-  const auto covariances = job_.plane_marginals();
+  StoreMarginals(job_.marginal_planes(), job_.plane_marginals());
+  static_cast<void>(job_.Release());
+  return true;
+}
+
+void Distiller::StoreMarginals(std::span<const std::uint32_t> ids,
+                               std::span<const Eigen::Matrix3d> covariances) {
   marginals_failed_ = covariances.size() != ids.size();
   if (marginals_failed_) {
     ++stats_.marginal_failures;
-  } else {
-    ++stats_.marginal_updates;
-    for (std::size_t i = 0; i < ids.size(); ++i) {
-      if (ids[i] >= marginal_.size()) continue;
-      marginal_[ids[i]] = covariances[i];
-      marginal_known_[ids[i]] = 1;
-    }
+    return;
   }
-  static_cast<void>(job_.Release());
-  return true;
+  ++stats_.marginal_updates;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (ids[i] >= marginal_.size()) continue;
+    marginal_[ids[i]] = covariances[i];
+    marginal_known_[ids[i]] = 1;
+  }
 }
 
 void Distiller::FindEligible(const SGraph& graph) {
@@ -95,7 +98,7 @@ void Distiller::FindEligible(const SGraph& graph) {
 bool Distiller::BeginMarginals(const SGraph& graph) {
   if (!config_.marginal_covariances || job_.pending()) return false;
   const std::uint64_t revision = graph.stats().revision;
-  if (job_begun_once_ && revision == job_revision_) return false;  // they are known
+  if (job_revision_ == revision) return false;  // they are known
   FindEligible(graph);
   if (eligible_.empty()) return false;
   if (!graph.BeginPlaneMarginals(job_, eligible_.span())) {
@@ -103,7 +106,6 @@ bool Distiller::BeginMarginals(const SGraph& graph) {
     ++stats_.marginal_failures;
     return false;
   }
-  job_begun_once_ = true;
   job_revision_ = revision;
   ++stats_.marginals_begun;
   return true;
@@ -112,16 +114,11 @@ bool Distiller::BeginMarginals(const SGraph& graph) {
 void Distiller::MarginalsNow(const SGraph& graph) {
   // On the graph's own problem, as before the background path existed (the job's copy gives
   // the same to rounding; this keeps the evaluation's lock-step missions bit for bit).
-  marginals_failed_ = !graph.PlaneMarginals(eligible_.span(), now_);
-  if (marginals_failed_) {
-    ++stats_.marginal_failures;
-    return;
-  }
-  ++stats_.marginal_updates;
-  for (std::size_t i = 0; i < eligible_.size(); ++i) {
-    marginal_[eligible_[i]] = now_[i];
-    marginal_known_[eligible_[i]] = 1;
-  }
+  // A failure passes no covariances: StoreMarginals counts it (eligible_ is never empty here).
+  const bool ok = static_cast<bool>(graph.PlaneMarginals(eligible_.span(), now_));
+  StoreMarginals(eligible_.span(),
+                 ok ? std::span<const Eigen::Matrix3d>(now_.data(), eligible_.size())
+                    : std::span<const Eigen::Matrix3d>());
 }
 
 bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, MarginalsTiming timing) {

@@ -30,6 +30,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "msgraphs/base/expected.hpp"
@@ -111,14 +113,15 @@ class Distiller {
   void FindEligible(const SGraph& graph);
   // Computes the marginals of eligible_ now, into marginal_.
   void MarginalsNow(const SGraph& graph);
+  // Takes computed covariances (one per id) into marginal_; a size mismatch is a failure.
+  void StoreMarginals(std::span<const std::uint32_t> ids, std::span<const Eigen::Matrix3d> covariances);
 
   std::vector<Eigen::Matrix3d> marginal_;     // per local plane id: its newest marginal
   std::vector<Eigen::Matrix3d> now_;          // kNow's, by position in eligible_
   std::vector<std::uint8_t> marginal_known_;  // per local plane id
   bool marginals_failed_ = false;             // the newest computation failed
   SGraphSolveJob job_;
-  std::uint64_t job_revision_ = 0;  // the S-Graph's when the job was begun
-  bool job_begun_once_ = false;
+  std::optional<std::uint64_t> job_revision_;  // the S-Graph's when the last job was begun
   Stats stats_;
   bool updated_once_ = false;
   std::uint64_t revision_ = 0;  // the S-Graph's at the last Update
