@@ -2,7 +2,7 @@
 // Distillation (Distiller): walls with covariances and rooms, sent again only when changed; the
 // walls' marginal covariances computed in the background (MarginalsTiming::kBackground) are the
 // ones computed on the spot for the graph they copied, and the Update that uses them allocates
-// nothing.
+// nothing; what is distilled holds the robot's own evidence only, whatever came back to it.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -206,6 +206,170 @@ TEST(Distiller, MarginalsFromTheBackgroundAreTheOnSpotOnesOfTheGraphTheyCopied) 
     EXPECT_TRUE(sent.walls[i].covariance.isApprox(spot.walls[i].covariance, 1e-9)) << i;
   // The graph lends nothing any more: it can be re-initialised.
   EXPECT_TRUE(f.graph.Init(f.config));
+}
+
+// What CollabSession::PlanePriors makes of a peer's distilled walls (the two maps share a frame
+// here): one prior per wall, its covariance as sent, `shift_m` added to its offset (a peer whose
+// origin is off). The priors of the last call are replaced, as LocalMapper::SetPlanePriors does.
+void FeedBack(SGraph& graph, const DistilledGraph& from, std::vector<std::uint32_t>& prior_ids,
+              double shift_m = 0) {
+  for (std::uint32_t id : prior_ids) ASSERT_TRUE(graph.RemoveFactor(id));
+  prior_ids.clear();
+  for (const DistilledWall& w : from.walls) {
+    PlanePrior prior;
+    prior.plane = w.id;
+    prior.normal = w.normal;
+    prior.d = w.d + shift_m;
+    prior.covariance = w.covariance;
+    auto id = graph.AddPlanePrior(prior);
+    ASSERT_TRUE(id);
+    prior_ids.push_back(*id);
+  }
+}
+
+// The distilled graph holds this robot's own evidence only: `now` against `own` (what it sent
+// before any prior), wall by wall and room by room.
+void ExpectOwnEvidence(const DistilledGraph& now, const std::vector<DistilledWall>& own_walls,
+                       const std::vector<DistilledRoom>& own_rooms, int round) {
+  ASSERT_EQ(now.walls.size(), own_walls.size()) << "round " << round;
+  for (std::size_t i = 0; i < own_walls.size(); ++i) {
+    EXPECT_EQ(now.walls[i].id, own_walls[i].id);
+    EXPECT_NEAR(now.walls[i].d, own_walls[i].d, 1e-5) << "round " << round << " wall " << i;
+    EXPECT_GT(now.walls[i].normal.dot(own_walls[i].normal), 1 - 1e-9);
+    EXPECT_TRUE(now.walls[i].covariance.isApprox(own_walls[i].covariance, 1e-3))
+        << "round " << round << " wall " << i << "\n" << now.walls[i].covariance << "\nvs own\n"
+        << own_walls[i].covariance;
+  }
+  ASSERT_EQ(now.rooms.size(), own_rooms.size());
+  for (std::size_t i = 0; i < own_rooms.size(); ++i) {
+    EXPECT_LT((now.rooms[i].centre - own_rooms[i].centre).norm(), 1e-5) << "round " << round;
+    EXPECT_NEAR(now.rooms[i].size_x_m, own_rooms[i].size_x_m, 1e-5);
+  }
+}
+
+// Rumour-free distillation (distiller.hpp): a robot whose walls come back to it as priors, from
+// itself (an echo 3 cm off, the worst case) or through a peer that feeds them into its own map
+// and distils again, sends what its own evidence says, round after round. A distiller that
+// took the graph as it is would send walls twice as certain after the first round (the
+// graph's marginals with the priors, checked beside) and pulled towards the echo.
+TEST(Distiller, ARobotThatGetsItsOwnWallsBackSendsOnlyItsOwnEvidence) {
+  DistillerConfig config;
+  config.resend_covariance_ratio = 1e-9;  // every change goes out: nothing is hidden
+  config.resend_distance_m = 1e-7;
+  config.resend_angle_rad = 1e-7;
+  // Robot a, and a peer b that saw the same room 2 cm further along x.
+  OneRoom a, b;
+  b.T_room.translation().x() += 0.02;
+  for (OneRoom* f : {&a, &b}) {
+    for (int k = 0; k < 3; ++k) f->AddKeyframe();
+    f->AddRoom();
+    ASSERT_TRUE(f->graph.Solve(SolveKind::kFull));
+  }
+  Distiller da, db;
+  ASSERT_TRUE(da.Init(1, a.config, config));
+  ASSERT_TRUE(db.Init(2, b.config, config));
+  ASSERT_TRUE(da.Update(a.graph, a.planes));
+  ASSERT_TRUE(db.Update(b.graph, b.planes));
+  const std::vector<DistilledWall> own_a(da.graph().walls.begin(), da.graph().walls.end());
+  const std::vector<DistilledRoom> own_ra(da.graph().rooms.begin(), da.graph().rooms.end());
+  const std::vector<DistilledWall> own_b(db.graph().walls.begin(), db.graph().walls.end());
+  const std::vector<DistilledRoom> own_rb(db.graph().rooms.begin(), db.graph().rooms.end());
+  ASSERT_EQ(own_a.size(), 4u);
+  ASSERT_EQ(own_ra.size(), 1u);
+
+  // The echo: a's own walls back into a, 3 cm off. A distiller that has seen a before and a
+  // fresh one (no memory of what a sent) both send the own evidence.
+  std::vector<std::uint32_t> priors_a, priors_b;
+  for (int round = 1; round <= 4; ++round) {
+    ASSERT_NO_FATAL_FAILURE(FeedBack(a.graph, da.graph(), priors_a, 0.03));
+    ASSERT_TRUE(a.graph.Solve(SolveKind::kFull));
+    EXPECT_TRUE(a.graph.estimates_hold_priors());
+    da.Update(a.graph, a.planes);
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(da.graph(), own_a, own_ra, round));
+    Distiller fresh;
+    ASSERT_TRUE(fresh.Init(1, a.config, config));
+    ASSERT_TRUE(fresh.Update(a.graph, a.planes));
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(fresh.graph(), own_a, own_ra, round));
+    EXPECT_EQ(fresh.stats().own_evidence_jobs, 1u);
+  }
+  EXPECT_EQ(da.stats().walls_awaiting_marginals + da.stats().walls_awaiting_estimates +
+                da.stats().rooms_awaiting_estimates + da.stats().own_solve_failures +
+                da.stats().own_solve_unconverged,
+            0u);
+  // The priors are in the graph: its estimates moved towards them, and its marginals are
+  // about half its own (what it would have sent, had it distilled the graph as it is).
+  std::vector<std::uint32_t> ids;
+  for (const DistilledWall& w : own_a) ids.push_back(w.id);
+  std::vector<Eigen::Matrix3d> with_priors(ids.size());
+  ASSERT_TRUE(a.graph.PlaneMarginals(ids, with_priors));
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    EXPECT_GT(std::fabs(a.graph.plane(ids[i]).d - own_a[i].d), 0.005) << i;
+    EXPECT_LT(with_priors[i](2, 2), 0.7 * own_a[i].covariance(2, 2)) << i;
+  }
+  EXPECT_EQ(da.stats().own_evidence_jobs, 4u);
+
+  // Through a peer: b takes a's walls, a takes b's, four exchanges each way.
+  for (int round = 1; round <= 4; ++round) {
+    ASSERT_NO_FATAL_FAILURE(FeedBack(b.graph, da.graph(), priors_b));
+    ASSERT_TRUE(b.graph.Solve(SolveKind::kFull));
+    db.Update(b.graph, b.planes);
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(db.graph(), own_b, own_rb, round));
+    ASSERT_NO_FATAL_FAILURE(FeedBack(a.graph, db.graph(), priors_a));
+    ASSERT_TRUE(a.graph.Solve(SolveKind::kFull));
+    da.Update(a.graph, a.planes);
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(da.graph(), own_a, own_ra, round));
+  }
+  // b's map agrees with a's walls now (the priors pulled it), yet b still sends its own 2 cm.
+  EXPECT_NEAR(db.graph().walls[0].d, own_b[0].d, 1e-5);
+  EXPECT_GT(std::fabs(own_b[0].d - own_a[0].d), 0.015);
+  EXPECT_GT(std::fabs(b.graph.plane(own_b[0].id).d - own_b[0].d), 0.005);
+
+  // The peer goes: b's priors are removed, but until a full solve its map still holds their
+  // pull, and what it sends is still its own evidence. After the full solve the graph is
+  // distilled as it is again, and says the same.
+  for (std::uint32_t id : priors_b) ASSERT_TRUE(b.graph.RemoveFactor(id));
+  priors_b.clear();
+  EXPECT_TRUE(b.graph.estimates_hold_priors());
+  {
+    Distiller fresh;
+    ASSERT_TRUE(fresh.Init(2, b.config, config));
+    ASSERT_TRUE(fresh.Update(b.graph, b.planes));
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(fresh.graph(), own_b, own_rb, 5));
+    EXPECT_EQ(fresh.stats().own_evidence_jobs, 1u);
+  }
+  ASSERT_TRUE(b.graph.Solve(SolveKind::kFull));
+  EXPECT_FALSE(b.graph.estimates_hold_priors());
+  {
+    Distiller fresh;
+    ASSERT_TRUE(fresh.Init(2, b.config, config));
+    ASSERT_TRUE(fresh.Update(b.graph, b.planes));
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(fresh.graph(), own_b, own_rb, 6));
+    EXPECT_EQ(fresh.stats().own_evidence_jobs, 0u);
+  }
+
+  // The node's path: the job begun at the exchange and run on another thread gives the same.
+  a.AddKeyframe();
+  FeedBack(a.graph, db.graph(), priors_a);
+  ASSERT_TRUE(a.graph.Solve(SolveKind::kFull));
+  Distiller background, spot;
+  ASSERT_TRUE(background.Init(1, a.config, config));
+  ASSERT_TRUE(spot.Init(1, a.config, config));
+  ASSERT_TRUE(background.BeginMarginals(a.graph));
+  SGraphSolveJob* job = background.marginals_job();
+  ASSERT_NE(job, nullptr);
+  std::jthread worker([job] {
+    if (job->TryClaim()) job->Run();
+  });
+  worker.join();
+  ASSERT_TRUE(background.Update(a.graph, a.planes, MarginalsTiming::kBackground));
+  ASSERT_TRUE(spot.Update(a.graph, a.planes, MarginalsTiming::kNow));
+  const std::vector<DistilledWall> spot_walls(spot.graph().walls.begin(), spot.graph().walls.end());
+  const std::vector<DistilledRoom> spot_rooms(spot.graph().rooms.begin(), spot.graph().rooms.end());
+  ASSERT_EQ(spot_walls.size(), 4u);
+  ASSERT_EQ(spot_rooms.size(), 1u);
+  ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(background.graph(), spot_walls, spot_rooms, 0));
+  EXPECT_EQ(background.stats().own_evidence_jobs, 1u);
+  EXPECT_TRUE(a.graph.Init(a.config));  // nothing borrowed any more
 }
 
 }  // namespace

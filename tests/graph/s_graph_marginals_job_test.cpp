@@ -3,10 +3,11 @@
 // gives what PlaneMarginals gave when it began, while the graph goes on taking keyframes and
 // removing factors; it lends the graph's costs back when its Run ends; a removed cost is kept
 // only for the jobs begun before its removal; beginning allocates nothing; a job released unrun
-// runs nothing.
+// runs nothing; a kOwn job leaves the plane priors out.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <thread>
 #include <vector>
 
@@ -166,6 +167,91 @@ TEST(SGraphMarginalsJob, BeginAllocatesNothingAndAJobReleasedUnrunRunsNothing) {
   const std::uint32_t unknown = static_cast<std::uint32_t>(other.graph.plane_slots()) + 5;
   EXPECT_FALSE(other.graph.BeginPlaneMarginals(job, std::vector<std::uint32_t>{unknown}));
   EXPECT_FALSE(job.pending());
+}
+
+// PlaneEvidence::kOwn (rumour-free distillation): the plane priors, what other robots said, are
+// left out of the copy and the copy is solved without them: its covariances and estimates are
+// those of the graph before the priors came, however far they pulled it. Beginning one
+// allocates nothing.
+TEST(SGraphMarginalsJob, OwnEvidenceLeavesThePriorsOutAndSolvesWithoutThem) {
+  SGraphConfig config;
+  config.max_keyframes = 256;
+  RoomRow row(config);
+  for (int i = 0; i < 30; ++i) {
+    row.Step();
+    ASSERT_TRUE(row.graph.Solve(SolveKind::kLocal));
+  }
+  ASSERT_TRUE(row.graph.Solve(SolveKind::kFull));
+  const std::vector<std::uint32_t> walls = Walls(row.graph);
+  ASSERT_GE(walls.size(), 8u);
+  std::vector<Eigen::Matrix3d> own(walls.size());
+  ASSERT_TRUE(row.graph.PlaneMarginals(walls, own));
+  std::vector<double> own_d;
+  for (std::uint32_t id : walls) own_d.push_back(row.graph.plane(id).d);
+  const Eigen::Vector2d own_room = row.graph.room(0).centre;
+  SGraphSolveJob job;
+  ASSERT_TRUE(job.Init(config));
+  // Never pulled: a kOwn job is the graph as it is, not solved.
+  EXPECT_FALSE(row.graph.estimates_hold_priors());
+  ASSERT_TRUE(row.graph.BeginPlaneMarginals(job, walls, PlaneEvidence::kOwn));
+  job.Complete();
+  EXPECT_FALSE(job.own_solved());
+  ASSERT_EQ(job.plane_marginals().size(), walls.size());
+  EXPECT_TRUE(job.plane_marginals()[0].isApprox(own[0], 1e-9));
+  ASSERT_TRUE(job.Release());
+  // Three walls get a peer's word, as sure as this graph and one of its sigmas off (within the
+  // robust losses' quadratic range): the map follows part of the way.
+  std::vector<double> sigma_d;
+  for (std::size_t i = 0; i < 3; ++i) {
+    sigma_d.push_back(std::sqrt(own[i](2, 2)));
+    PlanePrior prior;
+    prior.plane = walls[i];
+    prior.normal = row.graph.plane(walls[i]).normal;
+    prior.d = own_d[i] + sigma_d[i];
+    prior.covariance = Eigen::Matrix3d(own[i].diagonal().asDiagonal());
+    ASSERT_TRUE(row.graph.AddPlanePrior(prior));
+  }
+  ASSERT_TRUE(row.graph.Solve(SolveKind::kFull));
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_GT(std::fabs(row.graph.plane(walls[i]).d - own_d[i]), 0.1 * sigma_d[i]) << i;
+  EXPECT_TRUE(row.graph.estimates_hold_priors());
+
+  // kAll: the graph as it is, priors and all.
+  ASSERT_TRUE(row.graph.BeginPlaneMarginals(job, walls, PlaneEvidence::kAll));
+  job.Complete();
+  EXPECT_EQ(job.priors_left_out(), 0u);
+  ASSERT_EQ(job.plane_marginals().size(), walls.size());
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_LT(job.plane_marginals()[i](2, 2), 0.7 * own[i](2, 2)) << i;
+  ASSERT_TRUE(job.Release());
+  // kOwn: as if the priors had never come.
+  ASSERT_TRUE(row.graph.BeginPlaneMarginals(job, walls, PlaneEvidence::kOwn));
+  job.Complete();
+  EXPECT_EQ(job.priors_left_out(), 3u);
+  EXPECT_TRUE(job.own_solved());
+  EXPECT_TRUE(job.own_solve_usable());
+  EXPECT_TRUE(job.own_solve_converged());
+  ASSERT_EQ(job.plane_marginals().size(), walls.size());
+  for (std::size_t i = 0; i < walls.size(); ++i) {
+    EXPECT_TRUE(job.plane_marginals()[i].isApprox(own[i], 1e-3)) << i;
+    Eigen::Vector3d n;
+    double d = 0;
+    ASSERT_TRUE(job.PlaneEstimate(walls[i], n, d));
+    EXPECT_NEAR(d, own_d[i], 2e-5) << i;  // the solver's tolerance; the pull was 30x that
+  }
+  Eigen::Vector2d centre;
+  ASSERT_TRUE(job.RoomCentre(0, centre));
+  EXPECT_LT((centre - own_room).norm(), 1e-5);
+  EXPECT_FALSE(job.RoomCentre(1000, centre));
+  ASSERT_TRUE(job.Release());
+  // Beginning one allocates nothing (the list of priors to leave out is sized at Init).
+  std::size_t allocations = 0;
+  {
+    test::AllocationScope scope;
+    ASSERT_TRUE(row.graph.BeginPlaneMarginals(job, walls, PlaneEvidence::kOwn));
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  ASSERT_TRUE(job.Release());
 }
 
 }  // namespace

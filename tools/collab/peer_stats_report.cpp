@@ -35,7 +35,7 @@ std::string SessionStatsLine(int robot, const core::CollabSessionStats& st) {
       "robot %d session: %zu own rooms (peak room cloud %zu points), %zu peers, stores %.1f MB; "
       "refused: rooms %llu, clouds too large %llu, descriptors %llu, pending %llu, matches %llu; "
       "cache evictions %llu; solves %llu (%llu failed); marginal wall covariances %llu times "
-      "(%llu fell back); places: %llu asked, %llu received, %llu served, %llu refused, %llu "
+      "(%llu fell back; %llu solved without peers' priors, %llu of those failed); places: %llu asked, %llu received, %llu served, %llu refused, %llu "
       "unanswered, %llu unsolicited; %llu decisions weighed on them, %llu transforms set aside\n",
       robot, st.own_rooms, st.room_points_peak, st.peers, static_cast<double>(st.store_bytes) / 1e6,
       static_cast<unsigned long long>(st.rooms_refused),
@@ -48,6 +48,8 @@ std::string SessionStatsLine(int robot, const core::CollabSessionStats& st) {
       static_cast<unsigned long long>(st.solve_failures),
       static_cast<unsigned long long>(st.marginal_updates),
       static_cast<unsigned long long>(st.marginal_failures),
+      static_cast<unsigned long long>(st.own_evidence_jobs),
+      static_cast<unsigned long long>(st.own_solve_failures),
       static_cast<unsigned long long>(st.place_requests_sent),
       static_cast<unsigned long long>(st.place_clouds_received),
       static_cast<unsigned long long>(st.place_requests_served),
@@ -107,6 +109,8 @@ void WriteSessionStats(JsonWriter& json, const core::CollabSessionStats& st) {
   json.Field("solve_failures", st.solve_failures);
   json.Field("marginal_updates", st.marginal_updates);
   json.Field("marginal_failures", st.marginal_failures);
+  json.Field("own_evidence_jobs", st.own_evidence_jobs);
+  json.Field("own_solve_failures", st.own_solve_failures);
   json.Field("undecided_peers", st.undecided);
   json.Field("decisions", st.decisions);
   json.Field("merges", st.merges);

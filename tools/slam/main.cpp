@@ -50,6 +50,8 @@ using Clock = std::chrono::steady_clock;
 // Per-stage wall time of every keyframe.
 class Timer final : public core::StageObserver {
  public:
+  /// The growth table's runs: 300 keyframes, the map size the bound is stated against.
+  static constexpr std::size_t kGrowthKeyframes = 300;
   void KeyframeStarted() override {
     start_ = last_ = Clock::now();
     active_ = true;
@@ -80,6 +82,16 @@ class Timer final : public core::StageObserver {
     }
     std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "total", Percentile(total_, 0.5),
                 Percentile(total_, 0.9), Percentile(total_, 0.99), Percentile(total_, 1.0));
+    // How the cost grows with the map (issue 19's bound: p99 at 4,000 keyframes against 300):
+    // the total of each run of kGrowthKeyframes keyframes in turn.
+    std::printf("per keyframe total by map size [ms]   p50     p99     max\n");
+    for (std::size_t first = 0; first < total_.size(); first += kGrowthKeyframes) {
+      const std::size_t last = std::min(total_.size(), first + kGrowthKeyframes);
+      const std::vector<double> run(total_.begin() + static_cast<std::ptrdiff_t>(first),
+                                    total_.begin() + static_cast<std::ptrdiff_t>(last));
+      std::printf("  keyframes %5zu-%-5zu         %7.2f %7.2f %7.2f\n", first, last - 1,
+                  Percentile(run, 0.5), Percentile(run, 0.99), Percentile(run, 1.0));
+    }
     std::printf("per sweep between keyframes [ms] (scan tracking), %zu sweeps\n", sweeps_.size());
     std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "sweep", Percentile(sweeps_, 0.5),
                 Percentile(sweeps_, 0.9), Percentile(sweeps_, 0.99), Percentile(sweeps_, 1.0));

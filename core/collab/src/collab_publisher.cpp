@@ -70,6 +70,11 @@ void CollabPublisher::Prepare(const LocalMapper& mapper,
   stats_.marginals_run_at_prepare = d.marginals_run_at_update;
   stats_.marginals_not_ready = d.marginals_not_ready;
   stats_.walls_awaiting_marginals = d.walls_awaiting_marginals;
+  stats_.own_evidence_jobs = d.own_evidence_jobs;
+  stats_.own_solve_failures = d.own_solve_failures;
+  stats_.own_solve_unconverged = d.own_solve_unconverged;
+  stats_.walls_awaiting_estimates = d.walls_awaiting_estimates;
+  stats_.rooms_awaiting_estimates = d.rooms_awaiting_estimates;
   const DistilledGraph& g = distiller_.graph();
   out.graph.CopyFrom(g);  // capacities sized alike
 

@@ -65,7 +65,7 @@ Status CollabSessionConfig::Validate() const {
   if (!(descriptor_resend_m > 0) || !(anchored_translation_m > 0) || !(anchored_rotation_rad > 0) ||
       !(fine_origin_sigma_m > 0) || !(fine_origin_sigma_rad > 0) || request_retry_calls < 1 ||
       !(wall_pair_angle_rad > 0) || !(wall_pair_offset_m > 0) || max_wall_pairs < 1 ||
-      !(feedback_inflation >= 1) || !(feedback_sigma_floor_m > 0) ||
+      !(feedback_sigma_floor_m > 0) ||
       !(feedback_sigma_floor_rad > 0)) {
     return Error{Errc::kInvalidConfig, "collab session: thresholds and sigmas must be positive"};
   }
@@ -231,6 +231,8 @@ Status CollabSession::Ingest(CollabExchange& x, const CollabPublisherStats& from
   Impl& m = *impl_;
   m.stats.marginal_updates = from.marginal_updates;
   m.stats.marginal_failures = from.marginal_failures;
+  m.stats.own_evidence_jobs = from.own_evidence_jobs;
+  m.stats.own_solve_failures = from.own_solve_failures;
   m.stats.free_space_build_failures = from.free_space_build_failures;
   m.stats.rooms_refused = from.rooms_refused;
   m.own_clouds_too_large = from.room_clouds_too_large;

@@ -151,7 +151,8 @@ std::size_t CollabSession::PlanePriors(std::span<PlanePrior> out) const {
     prior.normal = (T.linear() * B->normal).normalized();
     prior.d = B->d - prior.normal.dot(T.translation());
     const double fm = m.config.feedback_sigma_floor_m, fr = m.config.feedback_sigma_floor_rad;
-    prior.covariance = m.config.feedback_inflation * B->covariance;
+    // The peer's own evidence (rumour-free): taken as it is, with the origin's floors.
+    prior.covariance = B->covariance;
     prior.covariance.diagonal() += Eigen::Vector3d(fr * fr, fr * fr, fm * fm);
     const DistilledWall* A = mine.FindWall(q.own_wall);
     if (A != nullptr && m.config.feedback_gate_chi2 > 0 && PriorDisagreement(prior, *A) > m.config.feedback_gate_chi2) {

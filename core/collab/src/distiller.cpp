@@ -34,6 +34,11 @@ Status Distiller::Init(std::uint16_t robot,
   marginal_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
   now_.assign(graph.max_planes, Eigen::Matrix3d::Zero());
   marginal_known_.assign(graph.max_planes, 0);
+  own_plane_.assign(graph.max_planes, Eigen::Vector4d::Zero());
+  own_room_.assign(graph.max_rooms, Eigen::Vector2d::Zero());
+  own_plane_known_.assign(graph.max_planes, 0);
+  own_room_known_.assign(graph.max_rooms, 0);
+  own_floor_known_ = false;
   marginals_failed_ = false;
   job_revision_.reset();
   stats_ = {};
@@ -53,8 +58,49 @@ bool Distiller::CollectMarginals() {
     job_.Run();  // nobody took it: the same result, on this thread
     ++stats_.marginals_run_at_update;
   }
+  TakeJob();
+  return true;
+}
+
+void Distiller::TakeJob() {
+  if (!job_.own_solve_usable()) {
+    // Nothing from it: the estimates and covariances of the newest usable job stand.
+    ++stats_.own_solve_failures;
+    static_cast<void>(job_.Release());
+    return;
+  }
+  if (job_.own_solved()) {
+    ++stats_.own_evidence_jobs;
+    if (!job_.own_solve_converged()) ++stats_.own_solve_unconverged;
+  }
   StoreMarginals(job_.marginal_planes(), job_.plane_marginals());
+  std::fill(own_plane_known_.begin(), own_plane_known_.end(), 0);
+  std::fill(own_room_known_.begin(), own_room_known_.end(), 0);
+  for (std::uint32_t id : job_.marginal_planes()) {
+    Eigen::Vector3d n;
+    double d = 0;
+    if (id < own_plane_.size() && job_.PlaneEstimate(id, n, d)) {
+      own_plane_[id] << n, d;
+      own_plane_known_[id] = 1;
+    }
+  }
+  for (std::uint32_t r = 0; r < own_room_.size(); ++r)
+    own_room_known_[r] = job_.RoomCentre(r, own_room_[r]) ? 1 : 0;
+  own_floor_known_ = job_.FloorCentre(own_floor_);
   static_cast<void>(job_.Release());
+}
+
+bool Distiller::WallEstimate(const SGraph& graph, std::uint32_t id, bool own, Eigen::Vector3d& n,
+                             double& d) const {
+  if (own) {
+    if (id >= own_plane_known_.size() || own_plane_known_[id] == 0) return false;
+    n = own_plane_[id].head<3>();
+    d = own_plane_[id][3];
+    return true;
+  }
+  const MapPlane p = graph.plane(id);
+  n = p.normal;
+  d = p.d;
   return true;
 }
 
@@ -101,7 +147,7 @@ bool Distiller::BeginMarginals(const SGraph& graph) {
   if (job_revision_ == revision) return false;  // they are known
   FindEligible(graph);
   if (eligible_.empty()) return false;
-  if (!graph.BeginPlaneMarginals(job_, eligible_.span())) {
+  if (!graph.BeginPlaneMarginals(job_, eligible_.span(), PlaneEvidence::kOwn)) {
     marginals_failed_ = true;  // the conditional covariances stand in until one succeeds
     ++stats_.marginal_failures;
     return false;
@@ -119,6 +165,25 @@ void Distiller::MarginalsNow(const SGraph& graph) {
   StoreMarginals(eligible_.span(),
                  ok ? std::span<const Eigen::Matrix3d>(now_.data(), eligible_.size())
                     : std::span<const Eigen::Matrix3d>());
+}
+
+void Distiller::ForgetOwnEstimates() {
+  std::fill(own_plane_known_.begin(), own_plane_known_.end(), 0);
+  std::fill(own_room_known_.begin(), own_room_known_.end(), 0);
+  own_floor_known_ = false;
+}
+
+void Distiller::OwnMarginalsNow(const SGraph& graph) {
+  static_cast<void>(job_.Release());
+  if (!graph.BeginPlaneMarginals(job_, eligible_.span(), PlaneEvidence::kOwn)) {
+    // Older own estimates are not the graph's now: nothing goes out until a job succeeds.
+    ForgetOwnEstimates();
+    marginals_failed_ = true;
+    ++stats_.marginal_failures;
+    return;
+  }
+  job_.Complete();  // nobody else has it: runs here
+  TakeJob();
 }
 
 bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, MarginalsTiming timing) {
@@ -141,12 +206,24 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
   revision_ = revision;
   const std::uint32_t next = out_.version + 1;
   bool changed = false;
+  // Rumour-free: while the graph's estimates may hold plane priors' pull, every estimate comes
+  // from the job that solved without them.
+  const bool own = config_.marginal_covariances && graph.estimates_hold_priors();
   // The walls to share, then (kNow) their marginal covariances from one factorisation.
   FindEligible(graph);
-  if (config_.marginal_covariances && !background && !eligible_.empty()) MarginalsNow(graph);
+  if (config_.marginal_covariances && !background) {
+    if (own && eligible_.empty())
+      ForgetOwnEstimates();  // no job: nothing of an older one goes out as now
+    else if (own)
+      OwnMarginalsNow(graph);
+    else if (!eligible_.empty())
+      MarginalsNow(graph);
+  }
   for (std::size_t i = 0; i < eligible_.size(); ++i) {
     const std::uint32_t id = eligible_[i];
     const MapPlane p = graph.plane(id);
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+    double offset = 0;
     // Its marginal: kNow's just computed, or kBackground's from the job BeginMarginals began.
     // Without one, after a failed computation the conditional covariance stands in; otherwise a
     // wall new since the job's copy waits for the next, never goes out overconfident.
@@ -154,6 +231,10 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
                        !(marginals_failed_ && !background);
     if (config_.marginal_covariances && !known && !marginals_failed_) {
       ++stats_.walls_awaiting_marginals;
+      continue;
+    }
+    if (!WallEstimate(graph, id, own, normal, offset)) {
+      ++stats_.walls_awaiting_estimates;  // not in the newest job
       continue;
     }
     Eigen::Matrix3d covariance =
@@ -174,15 +255,15 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
     } else {
       w = &out_.walls[static_cast<std::size_t>(wall_slot_[id])];
     }
-    const bool moved = w->version == 0 || std::fabs(w->d - p.d) > config_.resend_distance_m ||
-                       std::acos(std::min(1.0, w->normal.dot(p.normal))) > config_.resend_angle_rad;
+    const bool moved = w->version == 0 || std::fabs(w->d - offset) > config_.resend_distance_m ||
+                       std::acos(std::min(1.0, w->normal.dot(normal))) > config_.resend_angle_rad;
     const double trace_ratio = covariance.trace() / std::max(1e-300, w->covariance.trace());
     const bool sharper =
         std::fabs(std::log(trace_ratio)) > std::log(1.0 + config_.resend_covariance_ratio);
     const bool grew = e.valid && ((w->a - e.a).norm() > 0.1 || (w->b - e.b).norm() > 0.1);
     if (moved || sharper || grew) {
-      w->normal = p.normal;
-      w->d = p.d;
+      w->normal = normal;
+      w->d = offset;
       w->covariance = covariance;
       if (e.valid) {
         w->a = e.a;
@@ -199,6 +280,13 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
     d.id = r;
     d.shape = room.shape;
     d.centre = room.centre;
+    if (own) {
+      if (own_room_known_[r] == 0) {
+        ++stats_.rooms_awaiting_estimates;
+        continue;
+      }
+      d.centre = own_room_[r];
+    }
     bool complete = true;
     for (std::size_t i = 0; i < 4; ++i) {
       const std::int32_t w = room.walls[i];
@@ -210,25 +298,27 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
     }
     if (!complete) continue;  // its walls are not shareable yet
     // Frame and size from the walls: x along walls[0]'s normal; sizes wall to wall.
+    // Its walls' estimates (own: the job held them, their marginals came from it).
     auto line = [&](std::int32_t w, Eigen::Vector2d& n, double& off) {
-      const MapPlane p = graph.plane(static_cast<std::uint32_t>(w));
-      const double norm = p.normal.head<2>().norm();
-      n = p.normal.head<2>() / norm;
-      off = p.d / norm;
+      Eigen::Vector3d wall_n = Eigen::Vector3d::UnitX();
+      double wall_d = 0;
+      if (!WallEstimate(graph, static_cast<std::uint32_t>(w), own, wall_n, wall_d)) return false;
+      const double norm = wall_n.head<2>().norm();
+      n = wall_n.head<2>() / norm;
+      off = wall_d / norm;
+      return true;
     };
-    Eigen::Vector2d n0, n1;
-    double d0, d1;
-    line(room.walls[0], n0, d0);
-    line(room.walls[1], n1, d1);
+    Eigen::Vector2d n0 = Eigen::Vector2d::UnitX(), n1 = n0, n2 = n0, n3 = n0;
+    double d0 = 0, d1 = 0, d2 = 0, d3 = 0;
+    const bool four = room.shape == RoomShape::kFourWall;
+    if (!line(room.walls[0], n0, d0) || !line(room.walls[1], n1, d1) ||
+        (four && (!line(room.walls[2], n2, d2) || !line(room.walls[3], n3, d3)))) {
+      ++stats_.rooms_awaiting_estimates;  // a wall without an own estimate (not in the job)
+      continue;
+    }
     d.yaw_rad = std::atan2(n0.y(), n0.x());
     d.size_x_m = d0 + d1;
-    if (room.shape == RoomShape::kFourWall) {
-      Eigen::Vector2d n2, n3;
-      double d2, d3;
-      line(room.walls[2], n2, d2);
-      line(room.walls[3], n3, d3);
-      d.size_y_m = d2 + d3;
-    }
+    if (four) d.size_y_m = d2 + d3;
     DistilledRoom* slot = nullptr;
     if (room_slot_[r] < 0) {
       if (out_.rooms.size() == out_.rooms.capacity()) continue;
@@ -247,13 +337,18 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
       changed = true;
     }
   }
+  // The floor (own: once a job held it; until then the distilled graph keeps what it had).
   const bool has_floor = graph.has_floor();
-  if (has_floor && (!out_.has_floor || (out_.floor_centre - graph.floor_centre()).norm() >
-                                           config_.resend_distance_m)) {
-    out_.floor_centre = graph.floor_centre();
-    changed = true;
+  const Eigen::Vector2d floor_centre = own ? own_floor_ : graph.floor_centre();
+  if (has_floor && (!own || own_floor_known_)) {
+    if (!out_.has_floor || (out_.floor_centre - floor_centre).norm() > config_.resend_distance_m) {
+      out_.floor_centre = floor_centre;
+      changed = true;
+    }
+    out_.has_floor = true;
+  } else if (!has_floor) {
+    out_.has_floor = false;
   }
-  out_.has_floor = has_floor;
   out_.floor_z_m = config_.floor_z_m;
   if (changed) out_.version = next;
   return changed;

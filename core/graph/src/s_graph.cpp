@@ -49,6 +49,7 @@ Status SGraph::Init(const SGraphConfig& config) {
   if (m.OldestBorrower() != Impl::kNoBorrower)  // it would free the costs a job evaluates
     return Error{Errc::kWouldBlock, "a background solve job borrows from this graph"};
   m.full_job_pending = false;  // a full solve destroyed unfinished gave its slot back
+  m.prior_pull = false;
   m.config = config;
   ceres::Problem::Options options;
   // The graph owns the costs (RetireCost): a background solve may still be evaluating one the
@@ -445,6 +446,8 @@ Expected<std::uint32_t> SGraph::AddPlanePrior(const PlanePrior& prior) {
   m.factors[static_cast<std::size_t>(*slot)].id =
       m.problem->AddResidualBlock(cost, m.huber_plane.get(), p.n, p.d);
   ++m.stats.plane_prior_factors;
+  m.prior_pull = true;
+  ++m.prior_adds;
   return static_cast<std::uint32_t>(*slot);
 }
 
@@ -530,6 +533,7 @@ MapRoom SGraph::room(std::uint32_t id) const {
   return out;
 }
 bool SGraph::has_floor() const { return impl_->floor_active; }
+bool SGraph::estimates_hold_priors() const { return impl_->prior_pull; }
 Eigen::Vector2d SGraph::floor_centre() const { return {impl_->floor_c[0], impl_->floor_c[1]}; }
 
 std::size_t SGraph::RecentKeyframes(std::span<std::uint32_t> out) const {

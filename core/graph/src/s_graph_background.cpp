@@ -10,10 +10,10 @@
 // to its solution: it keeps its pose relative to the keyframe it was built on. Rooms and the
 // floor, which are re-centred by the room mapper between solves, get solved + (now - begin).
 //
-// A marginals job (BeginPlaneMarginals) takes the same copy; Run computes the planes'
-// covariances on it instead of solving and ends the job's borrowing of the graph's costs.
+// A marginals job (BeginPlaneMarginals) takes the same copy; Run (s_graph_solve_job.cpp)
+// computes the planes' covariances on it (after solving it without the plane priors, for a
+// kOwn copy of a graph they pulled) and ends the job's borrowing of the graph's costs.
 #include <ceres/ceres.h>
-#include <ceres/sphere_manifold.h>
 
 #include <algorithm>
 #include <array>
@@ -24,226 +24,21 @@
 
 #include "msgraphs/core/graph/s_graph.hpp"
 #include "msgraphs/core/graph/s_graph_solve_job.hpp"
-#include "s_graph_covariance.hpp"
-#include "s_graph_impl.hpp"
+#include "s_graph_solve_job_impl.hpp"
 
 namespace msgraphs::core {
-namespace {
 
-enum JobState : int { kIdle, kReady, kRunning, kDone };
-enum class JobKind { kFullSolve, kMarginals };
-
-// Every estimate of a graph, flat, by slot.
-struct Values {
-  std::vector<double> kq, kt, pn, pd, rc;
-  double floor[2] = {0, 0};
-
-  Eigen::Isometry3d Pose(std::size_t k) const { return sgraph::PoseOf(&kq[4 * k], &kt[3 * k]); }
-  bool Finite() const {
-    for (const auto* v : {&kq, &kt, &pn, &pd, &rc})
-      for (double x : *v)
-        if (!std::isfinite(x)) return false;
-    return std::isfinite(floor[0]) && std::isfinite(floor[1]);
-  }
-};
-
-struct JobResidual {
-  const ceres::CostFunction* cost = nullptr;
-  const ceres::LossFunction* loss = nullptr;
-  ceres::ResidualBlockId id = nullptr;  // in the graph's problem: FactorChi2 finds it by this
-  std::uint32_t first = 0, count = 0;   // its parameter blocks: refs[first, first + count)
-};
-
-}  // namespace
-
-struct SGraphSolveJob::Impl {
-  std::atomic<int> state{kIdle};
-  bool sized = false;
-  SGraphConfig config;
-  JobKind kind = JobKind::kFullSolve;
-  const void* graph = nullptr;  // the graph whose costs it borrows
-  // Its borrower slot in the graph while it borrows the graph's costs; ended once
-  // (EndBorrowing): by a marginals job's Run or Release, by a full solve's apply or drop. Only
-  // the thread that ends it touches this pointer (the claim orders Run against Release).
-  std::atomic<bool>* borrowing = nullptr;
-  Values begin, solved;
-  std::vector<double> stamp;  // keyframe slots are reused: a held keyframe has the same stamp
-  std::vector<std::uint8_t> keyframe_in, plane_in, room_in;
-  bool floor_in = false;
-  std::size_t keyframe_slots = 0, plane_count = 0, room_count = 0;
-  std::int32_t origin = kNone;
-  std::vector<JobResidual> residuals;
-  std::vector<double*> refs;  // into `solved`
-  std::vector<ceres::ResidualBlockId> ids;
-  ceres::EigenQuaternionManifold quaternion_manifold;
-  ceres::SphereManifold<3> sphere_manifold;
-  SGraphSolveReport report;
-  // A marginals job: the planes asked for, their blocks in `solved`, the result.
-  std::vector<std::uint32_t> marginal_ids;
-  std::vector<sgraph::PlaneBlocks> marginal_blocks;
-  std::vector<Eigen::Matrix3d> marginals;
-  bool marginals_ok = false;
-
-  void EndBorrowing() {
-    if (borrowing == nullptr) return;
-    borrowing->store(false, std::memory_order_release);  // after every use of the costs
-    borrowing = nullptr;
-  }
-
-  bool Held(std::size_t k, const KeyframeNode& now) const {
-    return k < keyframe_slots && keyframe_in[k] && stamp[k] == now.stamp_s;
-  }
-};
-
-SGraphSolveJob::SGraphSolveJob() : impl_(std::make_unique<Impl>()) {}
-SGraphSolveJob::~SGraphSolveJob() {
-  // A job that still borrows gives its slot back (its graph must still be there; a runner must
-  // have been joined): else the graph would keep every cost it removes, and refuse Init.
-  if (impl_->state.load() != kRunning) impl_->EndBorrowing();
-}
-
-Status SGraphSolveJob::Init(const SGraphConfig& config) {
-  if (auto s = config.Validate(); !s) return s;
-  Impl& j = *impl_;
-  if (j.state.load() != kIdle) return Error{Errc::kWouldBlock, "the job is pending"};
-  j.config = config;
-  const std::size_t keyframes = config.max_keyframes + 1, planes = config.max_planes,
-                    rooms = config.max_rooms;
-  for (Values* v : {&j.begin, &j.solved}) {
-    v->kq.assign(4 * keyframes, 0.0);
-    v->kt.assign(3 * keyframes, 0.0);
-    v->pn.assign(3 * planes, 0.0);
-    v->pd.assign(planes, 0.0);
-    v->rc.assign(2 * rooms, 0.0);
-  }
-  j.stamp.assign(keyframes, 0.0);
-  j.keyframe_in.assign(keyframes, 0);
-  j.plane_in.assign(planes, 0);
-  j.room_in.assign(rooms, 0);
-  // Every factor record is one residual block; a room's has the most parameter blocks (9).
-  j.residuals.reserve(config.max_factors);
-  j.ids.reserve(config.max_factors);
-  j.refs.reserve(config.max_factors * 4);
-  j.marginal_ids.reserve(planes);
-  j.marginal_blocks.reserve(planes);
-  j.marginals.assign(planes, Eigen::Matrix3d::Zero());
-  j.sized = true;
-  return Ok();
-}
-
-bool SGraphSolveJob::TryClaim() {
-  int expected = kReady;
-  return impl_->state.compare_exchange_strong(expected, kRunning, std::memory_order_acquire);
-}
-
-void SGraphSolveJob::Run() {
-  Impl& j = *impl_;
-  Values& x = j.solved;
-  SGraphSolveReport report;
-  // The problem lives in this scope only: "done" is published after it is gone, so a caller
-  // that saw done may drop the job.
-  {
-    ceres::Problem::Options options;
-    // Everything is borrowed: the graph's costs and losses, the job's manifolds and memory.
-    options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(options);
-    for (std::size_t k = 0; k < j.keyframe_slots; ++k) {
-      if (!j.keyframe_in[k]) continue;
-      problem.AddParameterBlock(&x.kq[4 * k], 4, &j.quaternion_manifold);
-      problem.AddParameterBlock(&x.kt[3 * k], 3);
-      if (static_cast<std::int32_t>(k) == j.origin) {  // the gauge, as in the graph
-        problem.SetParameterBlockConstant(&x.kq[4 * k]);
-        problem.SetParameterBlockConstant(&x.kt[3 * k]);
-      }
-    }
-    for (std::size_t i = 0; i < j.plane_count; ++i) {
-      if (!j.plane_in[i]) continue;
-      problem.AddParameterBlock(&x.pn[3 * i], 3, &j.sphere_manifold);
-      problem.AddParameterBlock(&x.pd[i], 1);
-    }
-    for (std::size_t i = 0; i < j.room_count; ++i)
-      if (j.room_in[i]) problem.AddParameterBlock(&x.rc[2 * i], 2);
-    if (j.floor_in) problem.AddParameterBlock(x.floor, 2);
-    for (const JobResidual& r : j.residuals) {
-      problem.AddResidualBlock(const_cast<ceres::CostFunction*>(r.cost),
-                               const_cast<ceres::LossFunction*>(r.loss), j.refs.data() + r.first,
-                               static_cast<int>(r.count));
-    }
-    report.kind = SolveKind::kFull;
-    std::size_t keyframes = 0;
-    for (std::size_t k = 0; k < j.keyframe_slots; ++k) keyframes += j.keyframe_in[k];
-    report.free_keyframes = keyframes > 0 ? keyframes - 1 : 0;
-    if (j.kind == JobKind::kMarginals) {
-      j.marginals_ok = static_cast<bool>(sgraph::PlaneCovariances(
-          problem, j.marginal_blocks, std::span(j.marginals).first(j.marginal_blocks.size())));
-      report.usable = report.converged = j.marginals_ok;
-    } else if (problem.NumResidualBlocks() == 0) {
-      report.usable = report.converged = true;
-    } else {
-      ceres::Solver::Summary summary;
-      ceres::Solve(sgraph::SolverOptions(j.config, SolveKind::kFull), &problem, &summary);
-      report.iterations = static_cast<int>(summary.iterations.size());
-      report.initial_cost = summary.initial_cost;
-      report.final_cost = summary.final_cost;
-      report.seconds = summary.total_time_in_seconds;
-      report.converged = summary.termination_type == ceres::CONVERGENCE;
-      report.usable = sgraph::SolverFinished(summary) && x.Finite();
-    }
-  }
-  j.report = report;
-  // The problem is gone: a marginals job needs the graph's costs no more.
-  if (j.kind == JobKind::kMarginals) j.EndBorrowing();
-  j.state.store(kDone, std::memory_order_release);
-  j.state.notify_all();
-}
-
-void SGraphSolveJob::Complete() {
-  if (TryClaim()) {
-    Run();
-    return;
-  }
-  Impl& j = *impl_;
-  for (int s = j.state.load(std::memory_order_acquire); s == kRunning;
-       s = j.state.load(std::memory_order_acquire)) {
-    j.state.wait(kRunning, std::memory_order_acquire);
-  }
-}
-
-bool SGraphSolveJob::pending() const { return impl_->state.load() != kIdle; }
-bool SGraphSolveJob::done() const { return impl_->state.load() == kDone; }
-const SGraphSolveReport& SGraphSolveJob::report() const { return impl_->report; }
-
-std::span<const std::uint32_t> SGraphSolveJob::marginal_planes() const {
-  return impl_->marginal_ids;
-}
-std::span<const Eigen::Matrix3d> SGraphSolveJob::plane_marginals() const {
-  const Impl& j = *impl_;
-  if (j.kind != JobKind::kMarginals || j.state.load(std::memory_order_acquire) != kDone ||
-      !j.marginals_ok)
-    return {};
-  return std::span(j.marginals).first(j.marginal_ids.size());
-}
-
-Status SGraphSolveJob::Release() {
-  Impl& j = *impl_;
-  if (j.state.load() == kIdle) return Ok();
-  if (j.kind != JobKind::kMarginals)
-    return Error{Errc::kInvalidArgument, "a full solve is finished by its graph"};
-  if (TryClaim())
-    j.EndBorrowing();  // nobody ran it: it is not run now, its borrowing just ends
-  else
-    Complete();  // a runner has it: wait
-  j.state.store(kIdle, std::memory_order_release);
-  j.graph = nullptr;
-  return Ok();
-}
+using sgraph::JobKind;
+using sgraph::JobResidual;
+using sgraph::kDone;
+using sgraph::kIdle;
+using sgraph::kReady;
+using sgraph::Values;
 
 Status SGraph::BeginFullSolve(SGraphSolveJob& job) {
   Impl& m = *impl_;
   if (m.full_job_pending) return Error{Errc::kWouldBlock, "a background solve is pending"};
-  if (auto s = CopyIntoJob(job); !s) return s;
+  if (auto s = CopyIntoJob(job, PlaneEvidence::kAll); !s) return s;
   SGraphSolveJob::Impl& j = *job.impl_;
   j.kind = JobKind::kFullSolve;
   m.full_job_pending = true;
@@ -251,7 +46,9 @@ Status SGraph::BeginFullSolve(SGraphSolveJob& job) {
   return Ok();
 }
 
-Status SGraph::BeginPlaneMarginals(SGraphSolveJob& job, std::span<const std::uint32_t> ids) const {
+Status SGraph::BeginPlaneMarginals(SGraphSolveJob& job,
+                                   std::span<const std::uint32_t> ids,
+                                   PlaneEvidence evidence) const {
   const Impl& m = *impl_;
   SGraphSolveJob::Impl& j = *job.impl_;
   if (j.sized && ids.size() > j.marginals.size())
@@ -260,7 +57,7 @@ Status SGraph::BeginPlaneMarginals(SGraphSolveJob& job, std::span<const std::uin
     if (id >= m.plane_count || !m.planes[id].in_problem)
       return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
   }
-  if (auto s = CopyIntoJob(job); !s) return s;
+  if (auto s = CopyIntoJob(job, evidence); !s) return s;
   j.kind = JobKind::kMarginals;
   j.marginal_ids.clear();
   j.marginal_blocks.clear();
@@ -275,7 +72,7 @@ Status SGraph::BeginPlaneMarginals(SGraphSolveJob& job, std::span<const std::uin
   return Ok();
 }
 
-Status SGraph::CopyIntoJob(SGraphSolveJob& job) const {
+Status SGraph::CopyIntoJob(SGraphSolveJob& job, PlaneEvidence evidence) const {
   Impl& m = *impl_;
   SGraphSolveJob::Impl& j = *job.impl_;
   if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
@@ -333,10 +130,31 @@ Status SGraph::CopyIntoJob(SGraphSolveJob& job) const {
     }
     return nullptr;
   };
+  // kOwn: the plane priors' residual blocks, sorted, to leave out (the job was sized from the
+  // same config: every factor fits).
+  j.left_out.clear();
+  if (evidence == PlaneEvidence::kOwn) {
+    for (std::size_t f = 0; f < m.factor_high_water; ++f) {
+      const FactorRecord& rec = m.factors[f];
+      if (!rec.active || rec.kind != FactorKind::kPlanePrior) continue;
+      if (j.left_out.size() == j.left_out.capacity())
+        return Error{Errc::kCapacityExceeded, "solve job sized for fewer factors than the graph"};
+      j.left_out.push_back(rec.id);
+    }
+    std::sort(j.left_out.begin(), j.left_out.end(), std::less<>());
+  }
+  j.priors_left_out = 0;
+  j.priors_at_copy = m.stats.plane_prior_factors;
+  j.prior_adds_at_copy = m.prior_adds;
+  j.own_solve_usable = j.own_solve_converged = true;
   m.problem->GetResidualBlocks(&j.ids);
   j.residuals.clear();
   j.refs.clear();
   for (ceres::ResidualBlockId id : j.ids) {
+    if (!j.left_out.empty() && std::binary_search(j.left_out.begin(), j.left_out.end(), id, std::less<>())) {
+      ++j.priors_left_out;
+      continue;
+    }
     JobResidual r;
     r.cost = m.problem->GetCostFunctionForResidualBlock(id);
     r.loss = m.problem->GetLossFunctionForResidualBlock(id);
@@ -352,6 +170,7 @@ Status SGraph::CopyIntoJob(SGraphSolveJob& job) const {
     r.count = static_cast<std::uint32_t>(m.scratch_blocks.size());
     j.residuals.push_back(r);
   }
+  j.solve_first = evidence == PlaneEvidence::kOwn && (j.priors_left_out > 0 || m.prior_pull);
   Impl::Borrower* borrower = m.TakeBorrower();
   if (borrower == nullptr)
     return Error{Errc::kWouldBlock, "too many jobs borrow from this graph"};
@@ -474,6 +293,8 @@ Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
     carry(r.c, &b.rc[2 * i], &x.rc[2 * i], i < j.room_count && j.room_in[i]);
   }
   if (m.problem->HasParameterBlock(m.floor_c)) carry(m.floor_c, b.floor, x.floor, j.floor_in);
+  // Solved without priors and none added since: their pull is gone.
+  if (report.converged && j.priors_at_copy == 0 && j.prior_adds_at_copy == m.prior_adds) m.prior_pull = false;
   ++m.stats.background_applied;
   DropFullSolve(job);
   return report;

@@ -199,6 +199,10 @@ struct SGraph::Impl {
   std::vector<RetiredCost> retired_costs;
   std::vector<const ceres::CostFunction*> scratch_costs;
   bool full_job_pending = false;  // one full solve at a time (ApplyFullSolve carries from it)
+  // Plane priors were added since the last converged full solve without any: the estimates may
+  // still hold their pull (estimates_hold_priors).
+  bool prior_pull = false;
+  std::uint64_t prior_adds = 0;  // AddPlanePrior calls that added one (a job notes it at its copy)
   SGraphStats stats;
 
   // The local solve's window problem (s_graph_solve.cpp): built per local solve from the

@@ -250,6 +250,9 @@ Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
   report.usable =
       sgraph::SolverFinished(summary) && (local ? m.WindowFinite() : m.StateFinite());
   if (!report.converged) ++m.stats.solves_not_converged;
+  // A converged full solve without priors holds none of their pull any more.
+  if (!local && report.converged && report.usable && m.stats.plane_prior_factors == 0)
+    m.prior_pull = false;
   if (!report.usable) {
     // A failed solve leaves the graph as it was.
     if (local) {

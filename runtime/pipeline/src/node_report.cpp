@@ -209,9 +209,12 @@ void Node::Impl::PrintReport() {
   Appendf(text,
           "  wall marginals: %" PRIu64 " computed (%" PRIu64 " failed), %" PRIu64
           " by the marginals thread; walls held back to the next exchange (shareable only after "
-          "the copy) %" PRIu64 " times\n",
+          "the copy) %" PRIu64 " times; own evidence (solved without peers' priors) %" PRIu64
+          " times, %" PRIu64 " not converged, %" PRIu64 " failed; walls / rooms held back for their own "
+          "estimates %" PRIu64 " / %" PRIu64 " times\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
-          ps.walls_awaiting_marginals);
+          ps.walls_awaiting_marginals, ps.own_evidence_jobs, ps.own_solve_unconverged,
+          ps.own_solve_failures, ps.walls_awaiting_estimates, ps.rooms_awaiting_estimates);
   const core::KeyframeCloudStore& store = mapper.clouds();
   const core::KeyframeCloudStoreStats& store_stats = store.stats();
   Appendf(text,
@@ -287,9 +290,11 @@ void Node::Impl::PrintReport() {
           ms.full_solves_waited);
   Appendf(stats,
           "marginal_updates %" PRIu64 "\nmarginal_failures %" PRIu64 "\nmarginals_thread_runs %" PRIu64
-          "\nwalls_awaiting_marginals %" PRIu64 "\n",
+          "\nwalls_awaiting_marginals %" PRIu64 "\nown_evidence_jobs %" PRIu64
+          "\nown_solve_unconverged %" PRIu64 "\nown_solve_failures %" PRIu64 "\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
-          ps.walls_awaiting_marginals);
+          ps.walls_awaiting_marginals, ps.own_evidence_jobs, ps.own_solve_unconverged,
+          ps.own_solve_failures);
   Appendf(stats,
           "cloud_store_clouds %zu\ncloud_store_evicted_covered %" PRIu64 "\ncloud_store_evicted_uncovered %" PRIu64
           "\ncloud_cover_cell_m %.2f\n",

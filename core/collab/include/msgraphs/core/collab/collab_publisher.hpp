@@ -76,6 +76,10 @@ struct CollabPublisherStats {
   std::uint64_t marginals_run_at_prepare = 0;   ///< kBackground: nobody had claimed the job
   std::uint64_t marginals_not_ready = 0;        ///< kBackground: its runner was not done
   std::uint64_t walls_awaiting_marginals = 0;   ///< summed over exchanges (Distiller::Stats)
+  /// Rumour-free distillation (Distiller::Stats): jobs that left peers' priors out, own-evidence
+  /// solves that failed, rooms held back for want of an own estimate (summed).
+  std::uint64_t own_evidence_jobs = 0, own_solve_unconverged = 0, own_solve_failures = 0;
+  std::uint64_t walls_awaiting_estimates = 0, rooms_awaiting_estimates = 0;
   std::uint64_t free_space_build_failures = 0;
   std::uint64_t rooms_refused = 0, room_clouds_too_large = 0, rooms_deferred = 0;
   std::size_t room_points_peak = 0;

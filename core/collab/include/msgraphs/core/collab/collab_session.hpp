@@ -124,10 +124,9 @@ struct CollabSessionConfig {
   double wall_pair_angle_rad = 0.26;  ///< walls of matched rooms paired within this angle
   double wall_pair_offset_m = 0.3;    ///< and this offset after the match transform
   std::size_t max_wall_pairs = 512;   ///< matched wall pairs held for PlanePriors
-  /// PlanePriors: the peer's wall covariance times `feedback_inflation` plus these floors for
-  /// the origin's uncertainty. Inflated because the peer's marginals may already hold what this
-  /// robot told it (each robot feeds the other's walls back into its own map).
-  double feedback_inflation = 2.0;
+  /// PlanePriors: the peer's wall covariance plus these floors for the origin's uncertainty.
+  /// Not inflated: the peer's walls hold its own evidence only, never what this robot told it
+  /// (rumour-free distillation, distiller.hpp), so feeding them back counts nothing twice.
   double feedback_sigma_floor_m = 0.01;
   double feedback_sigma_floor_rad = 0.005;
   /// A prior is fed back only while it agrees with this robot's own wall: the squared
@@ -211,6 +210,8 @@ struct CollabSessionStats {
   std::uint64_t solves = 0, solve_failures = 0;
   /// Distillations with marginal wall covariances, and those that fell back to conditional ones.
   std::uint64_t marginal_updates = 0, marginal_failures = 0;
+  /// Rumour-free distillation (CollabPublisherStats): solved without peers' priors, and failed.
+  std::uint64_t own_evidence_jobs = 0, own_solve_failures = 0;
   std::uint64_t requests_sent = 0, requests_served = 0, requests_unknown = 0;
   /// The fallback: place clouds asked for, received, served; requests refused (a peer's byte
   /// budget spent, or the queue full), never answered, clouds not asked for; decisions weighed

@@ -23,6 +23,21 @@
 // missions, a node whose inputs ended, the tests). When a computation fails (a rank-deficient
 // problem) the conditional covariances stand in for walls without a marginal.
 //
+// Rumour-free (issue 19): a robot's local S-Graph may hold plane priors, what its peers said
+// about its walls (CollabSession::PlanePriors). What it distils must not hold them, or a peer
+// would get its own information back as if it were new, and both would grow more certain with
+// every exchange (double counting). So the marginals job leaves the priors out
+// (PlaneEvidence::kOwn) and solves the copy without them; while the graph's estimates may hold
+// the priors' pull (SGraph::estimates_hold_priors: priors added since the last converged full
+// solve without any), every distilled estimate (walls, room centres and sizes, the floor) and
+// covariance comes from that job: this robot's own evidence, as of the job's copy. An element
+// the job did not hold (new since) waits for the next job. A graph never pulled is distilled
+// as before (estimates as they are at the Update; kNow bit for bit). Without
+// marginal_covariances there is no job: the conditional covariances hold no prior, but the
+// estimates then carry the priors' pull (not rumour-free: for tests and the allocation-free
+// path, not for a fleet that feeds back). Limits: a room's shape and walls are the graph's at
+// the Update, its centre the job's; data association and wall extents ran on the pulled map.
+//
 // Memory: stores and the marginals job are sized at Init. Update allocates nothing when the
 // marginals job was run elsewhere (kBackground) or without marginals; it allocates through Ceres
 // when it computes them itself. The graph must outlive a distiller whose job is pending (the job
@@ -97,6 +112,12 @@ class Distiller {
     /// walls held back, summed over Updates, because they had no marginal yet.
     std::uint64_t marginals_begun = 0, marginals_run_at_update = 0, marginals_not_ready = 0;
     std::uint64_t walls_awaiting_marginals = 0;
+    /// Rumour-free: jobs solved without the plane priors (own evidence), those of them that did
+    /// not converge within the iteration cap (their result is used), that failed (not used: the
+    /// distilled graph keeps what it had); walls and rooms held back, summed over Updates,
+    /// because the job that gives the own estimates did not hold them.
+    std::uint64_t own_evidence_jobs = 0, own_solve_unconverged = 0, own_solve_failures = 0;
+    std::uint64_t walls_awaiting_estimates = 0, rooms_awaiting_estimates = 0;
   };
   const Stats& stats() const { return stats_; }
 
@@ -115,10 +136,24 @@ class Distiller {
   void MarginalsNow(const SGraph& graph);
   // Takes computed covariances (one per id) into marginal_; a size mismatch is a failure.
   void StoreMarginals(std::span<const std::uint32_t> ids, std::span<const Eigen::Matrix3d> covariances);
+  // Takes a done job's covariances and estimates (the own evidence's), then releases it.
+  void TakeJob();
+  // kNow with the own evidence: the job run here, on this thread.
+  void OwnMarginalsNow(const SGraph& graph);
+  // No own estimate is known any more (until the next job succeeds).
+  void ForgetOwnEstimates();
+  // Where an element's estimate comes from: the graph now, or the newest job (own evidence).
+  bool WallEstimate(const SGraph& graph, std::uint32_t id, bool own, Eigen::Vector3d& n, double& d) const;
 
   std::vector<Eigen::Matrix3d> marginal_;     // per local plane id: its newest marginal
   std::vector<Eigen::Matrix3d> now_;          // kNow's, by position in eligible_
   std::vector<std::uint8_t> marginal_known_;  // per local plane id
+  // The newest job's estimates (own evidence), per local plane / room id, and the floor's.
+  std::vector<Eigen::Vector4d> own_plane_;
+  std::vector<Eigen::Vector2d> own_room_;
+  std::vector<std::uint8_t> own_plane_known_, own_room_known_;
+  Eigen::Vector2d own_floor_ = Eigen::Vector2d::Zero();
+  bool own_floor_known_ = false;
   bool marginals_failed_ = false;             // the newest computation failed
   SGraphSolveJob job_;
   std::optional<std::uint64_t> job_revision_;  // the S-Graph's when the last job was begun

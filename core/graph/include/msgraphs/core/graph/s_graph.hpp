@@ -80,6 +80,12 @@ struct PlaneMeasurement {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
 };
 
+/// What of a graph's evidence a marginals job keeps (SGraph::BeginPlaneMarginals).
+enum class PlaneEvidence : std::uint8_t {
+  kAll,  ///< the graph's problem as it is
+  kOwn,  ///< without the plane priors: the evidence of this graph's own observations only
+};
+
 /// An external measurement of a map plane: normal and offset in this map frame, covariance over
 /// (alpha, beta, delta_d) along WallBasis(normal) (distilled_graph.hpp).
 struct PlanePrior {
@@ -253,7 +259,15 @@ class SGraph {
   /// costs until Run returns; read the job after Complete, then Release it. kWouldBlock when the
   /// job is pending; kNotFound for a plane not in the optimisation; kCapacityExceeded beyond the
   /// job's plane capacity. No allocation.
-  Status BeginPlaneMarginals(SGraphSolveJob& job, std::span<const std::uint32_t> ids) const;
+  ///
+  /// PlaneEvidence::kOwn leaves the plane priors (AddPlanePrior: what other robots said) out of
+  /// the copy; when there were any, Run first solves the copy without them, so the job's
+  /// covariances and estimates (SGraphSolveJob::PlaneEstimate, RoomCentre, FloorCentre) hold
+  /// this graph's own evidence only: what a robot may tell others without telling them back
+  /// what they told it (rumour-free distillation, docs/multi-robot.md).
+  Status BeginPlaneMarginals(SGraphSolveJob& job,
+                             std::span<const std::uint32_t> ids,
+                             PlaneEvidence evidence = PlaneEvidence::kAll) const;
   /// FactorChi2 at the job's solution (done jobs only): how the solve that included the factor
   /// judges it, before applying. kNotFound when the factor was not in the job or was removed;
   /// kNotConverged when the job's solution is not usable (it judges nothing).
@@ -278,6 +292,10 @@ class SGraph {
   std::size_t room_slots() const;
   MapRoom room(std::uint32_t id) const;
   bool has_floor() const;
+  /// Plane priors were added since the last converged full solve without any (on the spot or
+  /// applied from the background): the estimates may hold what they said, even once they are
+  /// removed. A kOwn marginals job then solves its copy (BeginPlaneMarginals).
+  bool estimates_hold_priors() const;
   Eigen::Vector2d floor_centre() const;
   /// The newest keyframes (oldest first, up to out.size()) that are active.
   std::size_t RecentKeyframes(std::span<std::uint32_t> out) const;
@@ -287,8 +305,9 @@ class SGraph {
  private:
   struct Impl;
   // Copies every estimate and the residual blocks into a job (BeginFullSolve,
-  // BeginPlaneMarginals); the job then borrows the graph's costs.
-  Status CopyIntoJob(SGraphSolveJob& job) const;
+  // BeginPlaneMarginals), the plane priors' blocks left out with kOwn; the job then borrows the
+  // graph's costs.
+  Status CopyIntoJob(SGraphSolveJob& job, PlaneEvidence evidence) const;
   std::unique_ptr<Impl> impl_;
 };
 

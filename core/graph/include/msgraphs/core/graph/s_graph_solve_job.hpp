@@ -20,8 +20,9 @@
 // its timing: the copy is taken at a fixed point and applied at a fixed point.
 //
 // The same copy serves the walls' marginal covariances (SGraph::BeginPlaneMarginals): Run then
-// computes them at the copied estimates instead of solving, and the job lends the graph's costs
-// back as soon as Run returns; the caller reads the result after Complete and Releases the job.
+// computes them at the copied estimates instead of solving (or, for a copy without the plane
+// priors, after solving it without them), and the job lends the graph's costs back as soon as
+// Run returns; the caller reads the result after Complete and Releases the job.
 //
 // Memory: Init sizes the copy from the graph's config (allocates); BeginFullSolve and
 // ApplyFullSolve do not allocate beyond that. Run allocates (it builds a Ceres problem): it is
@@ -73,6 +74,21 @@ class SGraphSolveJob {
   /// covariances when the computation failed (a rank-deficient problem).
   std::span<const std::uint32_t> marginal_planes() const;
   std::span<const Eigen::Matrix3d> plane_marginals() const;
+  /// A marginals job, once done: the estimates its covariances were computed at (the copy's;
+  /// solved without the plane priors when a PlaneEvidence::kOwn copy left any out). False for
+  /// a plane, room or floor the copy did not hold, or before the job is done.
+  bool PlaneEstimate(std::uint32_t plane, Eigen::Vector3d& normal, double& d) const;
+  bool RoomCentre(std::uint32_t room, Eigen::Vector2d& centre) const;
+  bool FloorCentre(Eigen::Vector2d& centre) const;
+  /// Once done: the plane priors a kOwn copy left out; whether it was solved before its
+  /// covariances (priors left out, or the graph's estimates held their pull:
+  /// SGraph::estimates_hold_priors; otherwise its estimates are the graph's at the copy); that
+  /// solve finished with finite values (true when there was none), and converged (within its
+  /// iteration cap; no time limit).
+  std::size_t priors_left_out() const;
+  bool own_solved() const;
+  bool own_solve_usable() const;
+  bool own_solve_converged() const;
   /// A marginals job back to idle (its results go): one nobody claimed is not run, one running
   /// is waited for. A full solve is finished by its graph instead (ApplyFullSolve,
   /// DropFullSolve): kInvalidArgument.

@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: MIT
+// The solve job's state (s_graph_solve_job.hpp), shared by the job's own code
+// (s_graph_solve_job.cpp) and the graph's side that fills and applies it
+// (s_graph_background.cpp).
+#pragma once
+
+#include <ceres/ceres.h>
+#include <ceres/sphere_manifold.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
+#include "s_graph_covariance.hpp"
+#include "s_graph_impl.hpp"
+
+namespace msgraphs::core {
+namespace sgraph {
+
+enum JobState : int { kIdle, kReady, kRunning, kDone };
+enum class JobKind { kFullSolve, kMarginals };
+
+// Every estimate of a graph, flat, by slot.
+struct Values {
+  std::vector<double> kq, kt, pn, pd, rc;
+  double floor[2] = {0, 0};
+
+  Eigen::Isometry3d Pose(std::size_t k) const { return PoseOf(&kq[4 * k], &kt[3 * k]); }
+  bool Finite() const {
+    for (const auto* v : {&kq, &kt, &pn, &pd, &rc})
+      for (double x : *v)
+        if (!std::isfinite(x)) return false;
+    return std::isfinite(floor[0]) && std::isfinite(floor[1]);
+  }
+};
+
+struct JobResidual {
+  const ceres::CostFunction* cost = nullptr;
+  const ceres::LossFunction* loss = nullptr;
+  ceres::ResidualBlockId id = nullptr;  // in the graph's problem: FactorChi2 finds it by this
+  std::uint32_t first = 0, count = 0;   // its parameter blocks: refs[first, first + count)
+};
+
+}  // namespace sgraph
+
+struct SGraphSolveJob::Impl {
+  std::atomic<int> state{sgraph::kIdle};
+  bool sized = false;
+  SGraphConfig config;
+  sgraph::JobKind kind = sgraph::JobKind::kFullSolve;
+  const void* graph = nullptr;  // the graph whose costs it borrows
+  // Its borrower slot in the graph while it borrows the graph's costs; ended once
+  // (EndBorrowing): by a marginals job's Run or Release, by a full solve's apply or drop. Only
+  // the thread that ends it touches this pointer (the claim orders Run against Release).
+  std::atomic<bool>* borrowing = nullptr;
+  sgraph::Values begin, solved;
+  std::vector<double> stamp;  // keyframe slots are reused: a held keyframe has the same stamp
+  std::vector<std::uint8_t> keyframe_in, plane_in, room_in;
+  bool floor_in = false;
+  std::size_t keyframe_slots = 0, plane_count = 0, room_count = 0;
+  std::int32_t origin = sgraph::kNone;
+  std::vector<sgraph::JobResidual> residuals;
+  std::vector<double*> refs;  // into `solved`
+  std::vector<ceres::ResidualBlockId> ids;
+  // The graph's plane-prior residual blocks a kOwn copy leaves out (sorted), and how many it
+  // left out: with any, Run solves the copy before its covariances.
+  std::vector<ceres::ResidualBlockId> left_out;
+  std::size_t priors_left_out = 0;
+  std::size_t priors_at_copy = 0;       // the graph's plane priors when it was copied
+  std::uint64_t prior_adds_at_copy = 0;  // and its count of priors ever added
+  // A kOwn copy of a graph whose estimates may hold the priors' pull: Run solves it first.
+  bool solve_first = false;
+  bool own_solve_usable = true, own_solve_converged = true;
+  ceres::EigenQuaternionManifold quaternion_manifold;
+  ceres::SphereManifold<3> sphere_manifold;
+  SGraphSolveReport report;
+  // A marginals job: the planes asked for, their blocks in `solved`, the result.
+  std::vector<std::uint32_t> marginal_ids;
+  std::vector<sgraph::PlaneBlocks> marginal_blocks;
+  std::vector<Eigen::Matrix3d> marginals;
+  bool marginals_ok = false;
+
+  void EndBorrowing() {
+    if (borrowing == nullptr) return;
+    borrowing->store(false, std::memory_order_release);  // after every use of the costs
+    borrowing = nullptr;
+  }
+
+  bool Held(std::size_t k, const KeyframeNode& now) const {
+    return k < keyframe_slots && keyframe_in[k] && stamp[k] == now.stamp_s;
+  }
+  bool Done() const { return state.load(std::memory_order_acquire) == sgraph::kDone; }
+};
+
+}  // namespace msgraphs::core
