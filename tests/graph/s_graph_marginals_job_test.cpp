@@ -176,6 +176,9 @@ TEST(SGraphMarginalsJob, BeginAllocatesNothingAndAJobReleasedUnrunRunsNothing) {
 TEST(SGraphMarginalsJob, OwnEvidenceLeavesThePriorsOutAndSolvesWithoutThem) {
   SGraphConfig config;
   config.max_keyframes = 256;
+  // The reference (the graph's own full solve before the priors) must reach the optimum the
+  // job's solve (no time limit) reaches: under qemu a 2 s limit stopped it 0.15 mm short.
+  config.local_max_seconds = config.full_max_seconds = 600.0;
   RoomRow row(config);
   for (int i = 0; i < 30; ++i) {
     row.Step();
@@ -212,8 +215,11 @@ TEST(SGraphMarginalsJob, OwnEvidenceLeavesThePriorsOutAndSolvesWithoutThem) {
     ASSERT_TRUE(row.graph.AddPlanePrior(prior));
   }
   ASSERT_TRUE(row.graph.Solve(SolveKind::kFull));
-  for (std::size_t i = 0; i < 3; ++i)
-    EXPECT_GT(std::fabs(row.graph.plane(walls[i]).d - own_d[i]), 0.1 * sigma_d[i]) << i;
+  std::vector<double> pull_m;
+  for (std::size_t i = 0; i < 3; ++i) {
+    pull_m.push_back(std::fabs(row.graph.plane(walls[i]).d - own_d[i]));
+    EXPECT_GT(pull_m[i], 0.1 * sigma_d[i]) << i;
+  }
   EXPECT_TRUE(row.graph.estimates_hold_priors());
 
   // kAll: the graph as it is, priors and all.
@@ -236,7 +242,13 @@ TEST(SGraphMarginalsJob, OwnEvidenceLeavesThePriorsOutAndSolvesWithoutThem) {
     Eigen::Vector3d n;
     double d = 0;
     ASSERT_TRUE(job.PlaneEstimate(walls[i], n, d));
-    EXPECT_NEAR(d, own_d[i], 2e-5) << i;  // the solver's tolerance; the pull was 30x that
+    // Back at the own optimum, within the solvers' tolerances: the row slides along its length
+    // at almost no cost, and where the two solves stop there differs by up to 0.15 mm on
+    // aarch64 (5 um on x86_64), 4 % of a wall's sigma. The priors' pull is undone.
+    EXPECT_LT(std::fabs(d - own_d[i]), 0.1 * std::sqrt(own[i](2, 2))) << i;
+    if (i < 3) {
+      EXPECT_LT(std::fabs(d - own_d[i]), 0.25 * pull_m[i]) << i;
+    }
   }
   Eigen::Vector2d centre;
   ASSERT_TRUE(job.RoomCentre(0, centre));
