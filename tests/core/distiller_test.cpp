@@ -333,29 +333,26 @@ TEST(Distiller, ARobotThatGetsItsOwnWallsBackSendsOnlyItsOwnEvidence) {
   // The peer goes: b's priors are removed, but until a full solve its map still holds their
   // pull, and what it sends is still its own evidence. After the full solve the graph is
   // distilled as it is again, and says the same.
+  // b distilled by a distiller that never saw it: its own evidence, from a job solved without
+  // the priors (`own_jobs` 1) or from the graph as it is (0).
+  const auto distil_b_afresh = [&](std::uint64_t own_jobs, int round) {
+    Distiller fresh;
+    ASSERT_TRUE(fresh.Init(2, b.config, config));
+    ASSERT_TRUE(fresh.Update(b.graph, b.planes));
+    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(fresh.graph(), own_b, own_rb, round));
+    EXPECT_EQ(fresh.stats().own_evidence_jobs, own_jobs);
+  };
   for (std::uint32_t id : priors_b) ASSERT_TRUE(b.graph.RemoveFactor(id));
   priors_b.clear();
   EXPECT_TRUE(b.graph.estimates_hold_priors());
-  {
-    Distiller fresh;
-    ASSERT_TRUE(fresh.Init(2, b.config, config));
-    ASSERT_TRUE(fresh.Update(b.graph, b.planes));
-    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(fresh.graph(), own_b, own_rb, 5));
-    EXPECT_EQ(fresh.stats().own_evidence_jobs, 1u);
-  }
+  ASSERT_NO_FATAL_FAILURE(distil_b_afresh(1, 5));
   ASSERT_TRUE(b.graph.Solve(SolveKind::kFull));
   EXPECT_FALSE(b.graph.estimates_hold_priors());
-  {
-    Distiller fresh;
-    ASSERT_TRUE(fresh.Init(2, b.config, config));
-    ASSERT_TRUE(fresh.Update(b.graph, b.planes));
-    ASSERT_NO_FATAL_FAILURE(ExpectOwnEvidence(fresh.graph(), own_b, own_rb, 6));
-    EXPECT_EQ(fresh.stats().own_evidence_jobs, 0u);
-  }
+  ASSERT_NO_FATAL_FAILURE(distil_b_afresh(0, 6));
 
   // The node's path: the job begun at the exchange and run on another thread gives the same.
   a.AddKeyframe();
-  FeedBack(a.graph, db.graph(), priors_a);
+  ASSERT_NO_FATAL_FAILURE(FeedBack(a.graph, db.graph(), priors_a));
   ASSERT_TRUE(a.graph.Solve(SolveKind::kFull));
   Distiller background, spot;
   ASSERT_TRUE(background.Init(1, a.config, config));
