@@ -12,11 +12,16 @@
 // truth; --fitness-floor and --fitness-outlier-z set the gate as the node's [mapping] keys do.
 // --odometry-from-truth feeds the ground truth (at 50 Hz, interpolated) as the encoders: what is
 // left of the ATE is the front end's and the graph's own (docs/s-graph.md, "Plane covariance").
+// --speed X paces the scans at X times the recorded rate instead of as fast as possible (each
+// scan waits for its recorded time from the first, divided by X): the background full solve
+// then has the time it has onboard at X = 1, or 1/X of it (the schedule counts keyframes
+// either way).
 //
 //   msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] [--max-keyframes N]
 //                 [--matches FILE] [--fitness-floor M2] [--fitness-outlier-z Z]
-//                 [--odometry-from-truth]
+//                 [--odometry-from-truth] [--speed X]
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -55,16 +60,34 @@ class Timer final : public core::StageObserver {
   void KeyframeStarted() override {
     start_ = last_ = Clock::now();
     active_ = true;
+    pending_.fill(-1);
   }
   void StageEnded(core::MapperStage stage) override {
     const auto now = Clock::now();
-    stages_[static_cast<std::size_t>(stage)].push_back(
-        std::chrono::duration<double, std::milli>(now - last_).count());
+    pending_[static_cast<std::size_t>(stage)] =
+        std::chrono::duration<double, std::milli>(now - last_).count();
     last_ = now;
     if (stage == core::MapperStage::kRooms && active_) {
+      // A keyframe's stages are kept only once it is mapped (a refused keyframe ends early), so
+      // every stage's n-th entry is the n-th keyframe's.
+      for (std::size_t s = 0; s < stages_.size(); ++s)
+        stages_[s].push_back(std::max(0.0, pending_[s]));  // a stage not run took 0
       total_.push_back(std::chrono::duration<double, std::milli>(now - start_).count());
       active_ = false;
+      // The resident set at the end of each run, to see whether memory is flat (issue 19).
+      last_rss_mb_ = ResidentMb();
+      if (total_.size() % kGrowthKeyframes == 0) rss_mb_.push_back(last_rss_mb_);
     }
+  }
+  /// The process's resident set now (Linux /proc; 0 where it cannot be read).
+  static double ResidentMb() {
+    std::FILE* f = std::fopen("/proc/self/statm", "r");
+    if (f == nullptr) return 0;
+    unsigned long long size_pages = 0, resident_pages = 0;
+    const int read = std::fscanf(f, "%llu %llu", &size_pages, &resident_pages);
+    std::fclose(f);
+    if (read != 2) return 0;
+    return static_cast<double>(resident_pages) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1e6;
   }
   static double Percentile(std::vector<double> v, double p) {
     if (v.empty()) return 0;
@@ -84,17 +107,33 @@ class Timer final : public core::StageObserver {
                 Percentile(total_, 0.9), Percentile(total_, 0.99), Percentile(total_, 1.0));
     // How the cost grows with the map (issue 19's bound: p99 at 4,000 keyframes against 300):
     // the total of each run of kGrowthKeyframes keyframes in turn.
-    std::printf("per keyframe total by map size [ms]   p50     p99     max\n");
-    for (std::size_t first = 0; first < total_.size(); first += kGrowthKeyframes) {
+    std::printf("per keyframe total by map size [ms]   p50     p99     max  RSS at end [MB]\n");
+    for (std::size_t first = 0, run = 0; first < total_.size(); first += kGrowthKeyframes, ++run) {
       const std::size_t last = std::min(total_.size(), first + kGrowthKeyframes);
-      const std::vector<double> run(total_.begin() + static_cast<std::ptrdiff_t>(first),
-                                    total_.begin() + static_cast<std::ptrdiff_t>(last));
-      std::printf("  keyframes %5zu-%-5zu         %7.2f %7.2f %7.2f\n", first, last - 1,
-                  Percentile(run, 0.5), Percentile(run, 0.99), Percentile(run, 1.0));
+      const std::vector<double> v = Run(total_, first, last);
+      std::printf("  keyframes %5zu-%-5zu         %7.2f %7.2f %7.2f  %7.1f\n", first, last - 1,
+                  Percentile(v, 0.5), Percentile(v, 0.99), Percentile(v, 1.0),
+                  run < rss_mb_.size() ? rss_mb_[run] : last_rss_mb_);
+    }
+    // Which stages grow: each stage's p50 and p99 per run (one value per keyframe and stage).
+    std::printf("per stage by map size [ms], p50/p99 per run of %zu keyframes\n", kGrowthKeyframes);
+    for (std::size_t s = 0; s < stages_.size(); ++s) {
+      const auto& v = stages_[s];
+      std::printf("  %-18s", core::ToString(static_cast<core::MapperStage>(s)));
+      for (std::size_t first = 0; first < v.size(); first += kGrowthKeyframes) {
+        const std::vector<double> r = Run(v, first, std::min(v.size(), first + kGrowthKeyframes));
+        std::printf(" %.1f/%.1f", Percentile(r, 0.5), Percentile(r, 0.99));
+      }
+      std::printf("\n");
     }
     std::printf("per sweep between keyframes [ms] (scan tracking), %zu sweeps\n", sweeps_.size());
     std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "sweep", Percentile(sweeps_, 0.5),
                 Percentile(sweeps_, 0.9), Percentile(sweeps_, 0.99), Percentile(sweeps_, 1.0));
+  }
+  static std::vector<double> Run(const std::vector<double>& v, std::size_t first,
+                                 std::size_t last) {
+    return {v.begin() + static_cast<std::ptrdiff_t>(first),
+            v.begin() + static_cast<std::ptrdiff_t>(last)};
   }
   /// A sweep that was not a keyframe took this long in AddScan.
   void Sweep(double ms) { sweeps_.push_back(ms); }
@@ -102,7 +141,9 @@ class Timer final : public core::StageObserver {
 
  private:
   std::array<std::vector<double>, static_cast<std::size_t>(core::MapperStage::kCount)> stages_;
-  std::vector<double> total_, sweeps_;
+  std::vector<double> total_, sweeps_, rss_mb_;
+  std::array<double, static_cast<std::size_t>(core::MapperStage::kCount)> pending_{};
+  double last_rss_mb_ = 0;
   Clock::time_point start_, last_;
   bool active_ = false;
 };
@@ -144,6 +185,7 @@ int main(int argc, char** argv) {
   long full_solve_lag = -1;
   std::string matches_path;
   double fitness_floor_m2 = -1, fitness_outlier_z = -1;
+  double speed = 0;  // 0: as fast as possible
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--run" && i + 1 < argc)
@@ -162,6 +204,8 @@ int main(int argc, char** argv) {
       fitness_floor_m2 = std::atof(argv[++i]);
     else if (a == "--fitness-outlier-z" && i + 1 < argc)
       fitness_outlier_z = std::atof(argv[++i]);
+    else if (a == "--speed" && i + 1 < argc)
+      speed = std::atof(argv[++i]);
     else if (a == "--odometry-from-truth")
       odometry_from_truth = true;
     else if (a == "--markdown")
@@ -172,9 +216,13 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] "
                    "[--max-keyframes N] [--full-solve-lag N] [--matches FILE] [--fitness-floor M2] "
-                   "[--fitness-outlier-z Z] [--odometry-from-truth]\n");
+                   "[--fitness-outlier-z Z] [--odometry-from-truth] [--speed X]\n");
       return 2;
     }
+  }
+  if (!(speed >= 0) || !std::isfinite(speed)) {
+    std::fprintf(stderr, "slam: --speed must be a positive factor (0: as fast as possible)\n");
+    return 2;
   }
   const fs::path dir = fs::path(run) / ("robot" + std::to_string(robot));
   if (run.empty() || !fs::exists(dir / "velodyne.pcap") || !fs::exists(dir / "odometry.log")) {
@@ -255,6 +303,7 @@ int main(int argc, char** argv) {
   Timer timer;
   const auto t_start = Clock::now();
   std::size_t scan_count = 0;
+  double first_end_s = 0;
   while (const drivers::velodyne::Scan* next = scans->Next()) {
     const auto& scan = *next;
     ++scan_count;
@@ -266,6 +315,13 @@ int main(int argc, char** argv) {
     }
     core::LidarScanView view{points, times, scan.start_time.seconds_since_epoch(),
                              scan.end_time.seconds_since_epoch()};
+    if (speed > 0) {
+      // Paced: the scan is handed over when its sweep has ended, at the recorded rate x speed.
+      if (scan_count == 1) first_end_s = view.end_s;
+      std::this_thread::sleep_until(
+          t_start + std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::duration<double>((view.end_s - first_end_s) / speed)));
+    }
     feed_odometry_until(view.end_s + 0.05);
     const auto loops_before = mapper.loop_closer().stats().accepted;
     const auto rejected_before = mapper.loop_closer().stats().rejected_after_solve;

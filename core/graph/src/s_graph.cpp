@@ -81,6 +81,9 @@ Status SGraph::Init(const SGraphConfig& config) {
   m.free_factor_slots.reserve(config.max_factors);
   m.factor_high_water = m.active_factors = 0;
   m.retired_costs.reserve(config.max_factors);
+  m.plane_only_factors.clear();
+  m.plane_only_factors.reserve(config.max_factors);
+  m.held_epoch = 1;
   m.scratch_costs.reserve(1024);  // the residual blocks on one node (RemoveBlock)
   m.snapshot.assign(
       (config.max_keyframes + 1) * 7 + config.max_planes * 4 + config.max_rooms * 2 + 2, 0.0);
@@ -89,8 +92,23 @@ Status SGraph::Init(const SGraphConfig& config) {
       m.keyframes.size() * sizeof(KeyframeNode) + m.planes.size() * sizeof(PlaneNode) +
       m.rooms.size() * sizeof(RoomNode) + m.factors.size() * sizeof(FactorRecord) +
       m.snapshot.size() * sizeof(double) +
-      (m.free_keyframe_slots.capacity() + m.free_factor_slots.capacity()) * sizeof(std::int32_t);
+      (m.free_keyframe_slots.capacity() + m.free_factor_slots.capacity() +
+       m.plane_only_factors.capacity()) *
+          sizeof(std::int32_t);
   return Ok();
+}
+
+void SGraph::Impl::CompactPlaneOnlyFactors() {
+  const auto gone = [this](std::int32_t slot) {
+    const FactorRecord& f = factors[static_cast<std::size_t>(slot)];
+    return !f.active || (f.kind != FactorKind::kWallWall && f.kind != FactorKind::kPlanePrior);
+  };
+  plane_only_factors.erase(
+      std::remove_if(plane_only_factors.begin(), plane_only_factors.end(), gone),
+      plane_only_factors.end());
+  std::sort(plane_only_factors.begin(), plane_only_factors.end());
+  plane_only_factors.erase(std::unique(plane_only_factors.begin(), plane_only_factors.end()),
+                           plane_only_factors.end());
 }
 
 Expected<std::uint32_t> SGraph::AddKeyframe(double stamp_s,
@@ -262,6 +280,8 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
   }
   auto slot = m.NewFactor(FactorKind::kPlane, keyframe, plane);
   if (!slot) return slot.error();
+  // An observation by a keyframe the plane's held sum already covers: the sum is taken afresh.
+  if (m.keyframes[keyframe].stamp_s < p.held_before_s) p.held_epoch = 0;
   m.EnsurePlaneInProblem(p);
   auto* functor = new sgraph::PlaneResidual{z.basis_u, z.basis_v, z.d, sqrt_information};
   auto* cost = new sgraph::PlaneCost(functor);
@@ -279,7 +299,11 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
       p.info.basis_u.dot(T.translation()), p.info.basis_v.dot(T.translation()), 1;
   p.info.information += J.transpose() * information * J;
   ++p.info.observations;
-  p.info.last_keyframe = keyframe;
+  // The newest observer (the local solve frees a plane its window sees): an observation by an
+  // older keyframe does not move it back.
+  if (!m.ValidKeyframe(p.info.last_keyframe) ||
+      m.keyframes[p.info.last_keyframe].stamp_s <= m.keyframes[keyframe].stamp_s)
+    p.info.last_keyframe = keyframe;
   return Ok();
 }
 

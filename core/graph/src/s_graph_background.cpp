@@ -235,6 +235,7 @@ Expected<SGraphSolveReport> SGraph::ApplyFullSolve(SGraphSolveJob& job) {
     return report;
   }
   ++m.stats.revision;  // every call that may change the graph
+  ++m.held_epoch;      // held keyframes move: every held sum is taken afresh
   // The newest keyframe the job held that is still here: what a newer node was built on.
   std::int32_t anchor = m.newest;
   while (anchor != kNone &&

@@ -12,6 +12,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -55,10 +56,14 @@ struct PlaneNode {
   bool in_problem = false;
   bool window_free = false;  // moves in the current local solve (CollectWindow)
   // Its observations by keyframes the local solve holds, summed into one quadratic in
-  // x = [n; d] (s_graph_solve.cpp): x' H x - 2 g' x.
+  // x = [n; d] (s_graph_solve.cpp): x' H x - 2 g' x. The sum holds every observation by a
+  // keyframe stamped before held_before_s, and is current while held_epoch is the graph's
+  // (0: never, or invalidated).
   Eigen::Matrix4d held_H = Eigen::Matrix4d::Zero();
   Eigen::Vector4d held_g = Eigen::Vector4d::Zero();
   std::uint32_t held_observations = 0;
+  std::uint64_t held_epoch = 0;
+  double held_before_s = 0;
 };
 
 struct RoomNode {
@@ -214,6 +219,18 @@ struct SGraph::Impl {
   std::vector<double*> scratch_blocks;
   std::size_t window_residual_count = 0;  // residual blocks the last window problem held
   std::vector<std::unique_ptr<ceres::CostFunction>> window_costs;  // the held observations' sums
+  // The window's oldest free keyframe (kNone: none is free) and its stamp (+inf then): every
+  // keyframe stamped before it is held.
+  std::int32_t window_oldest_free = kNone;
+  double window_oldest_free_s = 0;
+  // Goes up whenever held keyframes may have moved or lost observations (a full solve, its
+  // application, sparsification): every plane's held sum is then taken afresh. Starts at 1.
+  std::uint64_t held_epoch = 1;
+  // Wall-wall and plane-prior factors (on planes only, no keyframe or room): the window takes
+  // those on a free plane from here, not from the plane's residual blocks, which are mostly
+  // its observations. May hold freed or reused slots (checked on use; compacted when full).
+  std::vector<std::int32_t> plane_only_factors;
+  void CompactPlaneOnlyFactors();
   // Which nodes move in a local solve: fills window_free; returns the free keyframes.
   std::size_t CollectWindow();
   void BuildWindowProblem();
@@ -221,10 +238,19 @@ struct SGraph::Impl {
   // buffer holds every block of the graph, so it holds the window's.
   void WindowSnapshot(bool restore);
   bool WindowFinite() const;
-  // Adds one held keyframe's observation of a free plane to the plane's held_H / held_g.
-  void SumHeldObservation(const sgraph::PlaneCost& cost,
+  // Adds one held keyframe's observation to the plane's held_H / held_g.
+  void SumHeldObservation(PlaneNode& plane,
+                          const sgraph::PlaneCost& cost,
                           const std::vector<double*>& blocks,
                           const ceres::LossFunction* loss);
+  // Brings every free plane's held sum up to the window (s_graph_held_sums.cpp).
+  void UpdateHeldSums();
+  void RebuildHeldSum(PlaneNode& plane);
+  // The free plane whose normal block this is (window_free_planes), or null.
+  PlaneNode* FreePlaneOf(const double* normal_block);
+  bool IsFreePlaneOffset(const double* block) const;
+  // The keyframe whose rotation block this is, or null.
+  const KeyframeNode* KeyframeOfBlock(const double* q) const;
 
   bool ValidKeyframe(std::uint32_t id) const {
     return id < keyframe_high_water && keyframes[id].active;
@@ -249,6 +275,16 @@ struct SGraph::Impl {
     } else {
       ++stats.rejected_capacity;
       return Error{Errc::kCapacityExceeded, "s-graph factor store full"};
+    }
+    if (kind == FactorKind::kWallWall || kind == FactorKind::kPlanePrior) {
+      // Compacted while this slot is still free: at most active_factors < max_factors stay.
+      // Also when stale entries outnumber live ones: priors are replaced at every exchange
+      // (LocalMapper::SetPlanePriors), and the window walks this list at every local solve.
+      const std::size_t live = stats.wall_wall_factors + stats.plane_prior_factors;
+      if (plane_only_factors.size() == plane_only_factors.capacity() ||
+          plane_only_factors.size() > 2 * live + 64)
+        CompactPlaneOnlyFactors();
+      plane_only_factors.push_back(slot);  // capacity max_factors (Init): never allocates
     }
     FactorRecord& f = factors[static_cast<std::size_t>(slot)];
     f = FactorRecord{};
@@ -277,6 +313,7 @@ struct SGraph::Impl {
         break;
       case FactorKind::kPlane:
         --stats.plane_factors;
+        if (f.b < planes.size()) planes[f.b].held_epoch = 0;  // its held sum may include it
         break;
       case FactorKind::kRoom:
         --stats.room_factors;

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "msgraphs/core/graph/s_graph.hpp"
@@ -45,6 +46,7 @@ std::size_t SGraph::Impl::CollectWindow() {
   // The newest keyframes, the origin never among them.
   std::int32_t window_start = newest;
   std::size_t free_keyframes = 0;
+  window_oldest_free = kNone;
   for (std::int32_t k = newest; k != kNone && free_keyframes < config.local_window_keyframes;
        k = keyframes[static_cast<std::size_t>(k)].prev) {
     window_start = k;
@@ -52,8 +54,13 @@ std::size_t SGraph::Impl::CollectWindow() {
     KeyframeNode& node = keyframes[static_cast<std::size_t>(k)];
     window_free.push_back(node.q);
     window_free.push_back(node.t);
+    window_oldest_free = k;
     ++free_keyframes;
   }
+  // Held: every keyframe stamped before the oldest free one (the origin among them).
+  window_oldest_free_s = window_oldest_free != kNone
+                             ? keyframes[static_cast<std::size_t>(window_oldest_free)].stamp_s
+                             : std::numeric_limits<double>::infinity();
   // A plane moves when its newest observer does: keyframe slots are reused, so compare stamps.
   const double window_stamp = keyframes[static_cast<std::size_t>(window_start)].stamp_s;
   for (std::size_t i = 0; i < plane_count; ++i) {
@@ -102,35 +109,40 @@ void SGraph::Impl::BuildWindowProblem() {
     if (!is_free(block) || problem->IsParameterBlockConstant(block))
       window->SetParameterBlockConstant(block);
   };
-  // Every residual block on a free node, once.
+  // Every residual block on a free node, once; not a free plane's own list (mostly its
+  // observations: a free keyframe's come with the keyframe, a held one's are in the plane's
+  // held sum), but the few factors on planes alone.
+  // With incremental_held_sums off, as before: every residual block on every free node, a free
+  // plane's observations by held keyframes picked out below (the reference the tests compare
+  // the incremental way against).
+  const bool incremental = config.incremental_held_sums;
   window_residuals.clear();
   for (double* block : window_free) {
+    if (incremental && (FreePlaneOf(block) != nullptr || IsFreePlaneOffset(block))) continue;
     problem->GetResidualBlocksForParameterBlock(block, &scratch_residuals);
     window_residuals.insert(window_residuals.end(), scratch_residuals.begin(),
                             scratch_residuals.end());
   }
+  for (std::int32_t slot : plane_only_factors) {
+    if (!incremental) break;
+    const FactorRecord& f = factors[static_cast<std::size_t>(slot)];
+    if (!f.active || (f.kind != FactorKind::kWallWall && f.kind != FactorKind::kPlanePrior))
+      continue;
+    problem->GetParameterBlocksForResidualBlock(f.id, &scratch_blocks);
+    if (std::any_of(scratch_blocks.begin(), scratch_blocks.end(), is_free))
+      window_residuals.push_back(f.id);
+  }
   std::sort(window_residuals.begin(), window_residuals.end());
   window_residuals.erase(std::unique(window_residuals.begin(), window_residuals.end()),
                          window_residuals.end());
-  for (const auto& [n, i] : window_free_planes) {
-    planes[i].held_H.setZero();
-    planes[i].held_g.setZero();
-    planes[i].held_observations = 0;
-  }
   std::size_t kept = 0;
   for (ceres::ResidualBlockId id : window_residuals) {
     problem->GetParameterBlocksForResidualBlock(id, &scratch_blocks);
     const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
-    const auto* plane_cost = dynamic_cast<const sgraph::PlaneCost*>(cost);
-    if (plane_cost != nullptr && !is_free(scratch_blocks[0])) {
-      // A free plane seen by a held keyframe: the floor is seen from every keyframe, a long
-      // wall from hundreds. With the keyframe held the residual is linear in the plane,
-      // e = A [n; d] - b, so all such observations of a plane sum exactly into one quadratic;
-      // each is weighted by its Huber kernel at the current estimate (a reweighted step).
-      SumHeldObservation(*plane_cost, scratch_blocks,
-                         problem->GetLossFunctionForResidualBlock(id));
+    // A held keyframe's observation of a free plane is in the plane's held sum (reached only
+    // through the plane's own list, i.e. with incremental_held_sums off): never twice.
+    if (dynamic_cast<const sgraph::PlaneCost*>(cost) != nullptr && !is_free(scratch_blocks[0]))
       continue;
-    }
     for (double* block : scratch_blocks) add_block(block);
     window->AddResidualBlock(const_cast<ceres::CostFunction*>(cost),
                              const_cast<ceres::LossFunction*>(
@@ -138,6 +150,10 @@ void SGraph::Impl::BuildWindowProblem() {
                              scratch_blocks.data(), static_cast<int>(scratch_blocks.size()));
     ++kept;
   }
+  // A free plane seen by held keyframes: the floor is seen from every keyframe, a long wall
+  // from hundreds. With the keyframe held the residual is linear in the plane,
+  // e = A [n; d] - b, so all such observations of a plane sum exactly into one quadratic.
+  UpdateHeldSums();
   for (const auto& [n, i] : window_free_planes) {
     PlaneNode& p = planes[i];
     if (p.held_observations == 0) continue;
@@ -150,39 +166,6 @@ void SGraph::Impl::BuildWindowProblem() {
     ++kept;
   }
   window_residual_count = kept;  // what Ceres is handed
-}
-
-void SGraph::Impl::SumHeldObservation(const sgraph::PlaneCost& cost,
-                                      const std::vector<double*>& blocks,
-                                      const ceres::LossFunction* loss) {
-  const sgraph::PlaneResidual& z = cost.functor();
-  const double* q = blocks[0];
-  const double* t = blocks[1];
-  const Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
-  Eigen::Matrix<double, 3, 4> A = Eigen::Matrix<double, 3, 4>::Zero();
-  A.block<1, 3>(0, 0) = (R * z.basis_u).transpose();
-  A.block<1, 3>(1, 0) = (R * z.basis_v).transpose();
-  A.block<1, 3>(2, 0) = Eigen::Vector3d(t[0], t[1], t[2]).transpose();
-  A(2, 3) = 1.0;
-  const Eigen::Vector3d b(0, 0, z.d_measured);
-  const Eigen::Matrix<double, 3, 4> SA = z.sqrt_information * A;
-  const Eigen::Vector3d Sb = z.sqrt_information * b;
-  double weight = 1.0;
-  if (loss != nullptr) {
-    const Eigen::Vector4d x(blocks[2][0], blocks[2][1], blocks[2][2], blocks[3][0]);
-    double rho[3];
-    loss->Evaluate((SA * x - Sb).squaredNorm(), rho);
-    weight = rho[1];
-  }
-  // Which plane: blocks[2] is its normal block.
-  const auto at = std::lower_bound(
-      window_free_planes.begin(), window_free_planes.end(), blocks[2],
-      [](const std::pair<const double*, std::uint32_t>& e, const double* n) { return e.first < n; });
-  if (at == window_free_planes.end() || at->first != blocks[2]) return;  // never: it is free
-  PlaneNode& p = planes[at->second];
-  p.held_H += weight * SA.transpose() * SA;
-  p.held_g += weight * SA.transpose() * Sb;
-  ++p.held_observations;
 }
 
 void SGraph::Impl::WindowSnapshot(bool restore) {
@@ -225,6 +208,7 @@ Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
                                              m.window_residual_count);
   } else {
     report.free_keyframes = m.active_keyframes > 0 ? m.active_keyframes - 1 : 0;
+    ++m.held_epoch;  // held keyframes move: every held sum is taken afresh
   }
   // Undo state: a local solve changes only its free blocks, so only those are kept (a full copy
   // would cost in proportion to the graph again).

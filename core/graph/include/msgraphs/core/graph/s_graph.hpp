@@ -58,6 +58,13 @@ struct SGraphConfig {
   std::size_t local_window_keyframes = 20;
   int local_max_iterations = 10;
   double local_max_seconds = 0.05;
+  /// A free plane's observations by held keyframes reach the local solve as one sum
+  /// (docs/s-graph.md, "Solves"). true: the sum is kept between solves and only what left the
+  /// window since is added, so a wall seen from a thousand keyframes (the floor: every one)
+  /// costs what the newest keyframes add; it is taken afresh after anything that moves a held
+  /// keyframe (a full solve, sparsification). false: summed afresh at every local solve, at a
+  /// cost that grows with the mission (the reference the incremental sum is tested against).
+  bool incremental_held_sums = true;
   /// Full solve (after a loop closure and every so often): everything but the origin moves.
   int full_max_iterations = 100;
   double full_max_seconds = 2.0;
@@ -161,6 +168,10 @@ struct SGraphStats {
   /// The most residual blocks a local solve's window problem held (its cost follows this, not
   /// the graph's size).
   std::size_t window_residuals_peak = 0;
+  /// Free planes whose held observations a local solve summed afresh (a full solve or
+  /// sparsification moved held keyframes since, or the plane was out of the window longer than
+  /// a window), and held observations added to a kept sum as their keyframes left the window.
+  std::uint64_t held_sums_rebuilt = 0, held_observations_added = 0;
   /// Full solves run in the background (SGraphSolveJob): applied, and refused as unusable.
   std::uint64_t background_applied = 0, background_unusable = 0;
   /// Removed cost functions kept because a job begun before their removal may still evaluate
