@@ -22,12 +22,11 @@
 #include "msgraphs/core/slam/loop_closer.hpp"
 #include "msgraphs/core/slam/odometry_buffer.hpp"
 #include "msgraphs/core/slam/plane_mapper.hpp"
+#include "box_room_walk.hpp"
 #include "synthetic_clouds.hpp"
 
 namespace msgraphs::core {
 namespace {
-
-Eigen::Isometry3d Pose(double x, double y, double yaw) { return test::PlanarPose(x, y, yaw); }
 
 TEST(OdometryBuffer, InterpolatesAndRefusesDisorder) {
   OdometryBuffer b;
@@ -179,74 +178,6 @@ TEST(LoopCloser, InformationKeepsTheHessiansShape) {
   EXPECT_TRUE(InformationFromHessian(bad, 0.02).isApprox(Matrix6d::Identity() / (0.02 * 0.02)));
 }
 
-// ---- the whole front end on a synthetic room -----------------------------------------------
-
-constexpr double kSx = 10.0, kSy = 8.0, kSz = 3.0;
-
-// A scan of the box room taken by a lidar 0.8 m above the floor at T_world_base.
-std::vector<Eigen::Vector3f> ScanAt(const Eigen::Isometry3d& T_world_base,
-                                    const LocalMapperConfig& config,
-                                    std::uint32_t seed, std::size_t points = 20000) {
-  const Eigen::Isometry3d T_lidar_world = (T_world_base * config.T_base_lidar).inverse();
-  return test::BoxRoom(kSx, kSy, kSz, points, 0.01, seed, T_lidar_world);
-}
-
-// The true path (base at 0.5 m) inside the room and odometry with 5 % scale error and yaw drift.
-// With `rock_deg`, the base rocks like a trotting legged robot's: pitch +-rock_deg alternating
-// from step to step and roll at two thirds of it (level at the start, as a robot stands).
-struct Walk {
-  std::vector<Eigen::Isometry3d> truth, odometry;
-  explicit Walk(int steps = 30, double rock_deg = 0.0) {  // 15 a lap
-    Eigen::Isometry3d odo = Eigen::Isometry3d::Identity();
-    for (int i = 0; i < steps; ++i) {
-      const double a = 2 * std::numbers::pi * i / 15.0;
-      Eigen::Isometry3d T =
-          Pose(5 + 2.5 * std::cos(a), 4 + 2.0 * std::sin(a), a + std::numbers::pi / 2);
-      T.translation().z() = 0.5;
-      if (i > 0 && rock_deg > 0) {
-        const double rock = rock_deg * std::numbers::pi / 180.0;
-        T.linear() = T.linear() *
-                     Eigen::AngleAxisd((i % 2 ? 1 : -1) * rock, Eigen::Vector3d::UnitY()) *
-                     Eigen::AngleAxisd(0.67 * rock * std::sin(0.9 * i), Eigen::Vector3d::UnitX());
-      }
-      if (i == 0) {
-        odo = T;
-      } else {
-        Eigen::Isometry3d delta = truth.back().inverse() * T;
-        delta.translation() *= 1.05;
-        delta.linear() = RotZ(0.01) * delta.linear();
-        odo = odo * delta;
-      }
-      truth.push_back(T);
-      odometry.push_back(odo);
-    }
-  }
-};
-
-// A mapper sized for the synthetic room: 20,000-point scans, a small grid around the room.
-LocalMapperConfig SmallConfig(std::size_t keyframes, int grid_cells) {
-  LocalMapperConfig config;
-  config.max_scan_points = 25000;
-  config.cloud_store_points = keyframes * 6000;
-  config.graph.max_keyframes = keyframes;
-  config.graph.max_factors = keyframes * 64;
-  config.grid.width = config.grid.height = grid_cells;
-  // Grid centred on the room (10 x 8 m, corner at the origin).
-  config.grid.origin_m = Eigen::Vector2f(5.0f, 4.0f) -
-                         Eigen::Vector2f::Constant(0.05f * static_cast<float>(grid_cells));
-  return config;
-}
-
-// Step i of a walk (one keyframe a second): its odometry around the sweep, then the sweep.
-auto FeedStep(LocalMapper& mapper, const LocalMapperConfig& config, const Walk& walk, std::size_t i,
-              std::span<const float> times) {
-  const double t = 10.0 + static_cast<double>(i);
-  EXPECT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
-  EXPECT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
-  const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
-  return mapper.AddScan({points, times, t - 0.1, t});
-}
-
 TEST(LocalMapper, WalksARoomWithBiasedOdometry) {
   const LocalMapperConfig config = SmallConfig(64, 256);
   LocalMapper mapper;
@@ -339,19 +270,6 @@ double WorstAfterASlip(double motion_seed_max_age_s, LocalMapperStats& stats) {
   }
   stats = mapper.stats();
   return worst;
-}
-
-// Steps [first, last) of the walk, one scan a second from t = 10 s, odometry bracketing each.
-void WalkSteps(LocalMapper& mapper, const Walk& walk, const LocalMapperConfig& config,
-               std::size_t first, std::size_t last) {
-  const std::vector<float> times(20000, 0.1f);  // every point taken at the end of the sweep
-  for (std::size_t i = first; i < last; ++i) {
-    const double t = 10.0 + static_cast<double>(i);
-    ASSERT_TRUE(mapper.AddOdometry(t - 0.15, walk.odometry[i]));
-    ASSERT_TRUE(mapper.AddOdometry(t + 0.05, walk.odometry[i]));
-    const auto points = ScanAt(walk.truth[i], config, static_cast<std::uint32_t>(i + 1));
-    ASSERT_TRUE(mapper.AddScan({points, times, t - 0.1, t}));
-  }
 }
 
 // A sensor or building whose every fitness is above the configured floor: the first matches
@@ -507,92 +425,6 @@ TEST(LocalMapper, KeyframesReplayedWithTheirTrackedMotionRebuildTheLiveMap) {
   bad.T_last_new.linear()(0, 0) = 2;
   EXPECT_FALSE(rebuilt.ReplayKeyframe({journal[0].first, times, 9.9, 10.0}, bad));
 }
-
-class Relocalisation : public ::testing::TestWithParam<double> {};
-
-TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
-  // A node killed at step 11 of the walk and restarted at step 14: its odometry integration
-  // begins again at identity, 2 m and 80 degrees of turning away from where the map stopped.
-  // With the base rocking (the parameter, degrees), neither the last keyframe's base nor the
-  // new one is level.
-  const LocalMapperConfig config = SmallConfig(64, 256);
-  LocalMapper mapper;
-  ASSERT_TRUE(mapper.Init(config));
-  const Walk walk(30, GetParam());
-  std::vector<float> times(20000, 0.1f);
-  WalkSteps(mapper, walk, config, 0, 12);
-  const SGraph& g = mapper.graph();
-  const std::uint32_t last = static_cast<std::uint32_t>(g.keyframe_slots() - 1);
-  const Eigen::Isometry3d T_map_odom =
-      g.keyframe_pose(last) * mapper.keyframe_odometry(last).inverse();
-  // Where the node stopped, and where it would be had it kept its last step's motion three
-  // more steps, times 1.5 (the caller's prediction over the downtime).
-  RelocaliseSearch search;
-  search.T_odom_from = walk.odometry[11];
-  const Eigen::Isometry3d step = walk.odometry[10].inverse() * walk.odometry[11];
-  Eigen::Isometry3d ahead = walk.odometry[11];
-  for (int k = 0; k < 4; ++k) ahead = ahead * step;
-  search.T_odom_to = ahead;
-  const auto points = ScanAt(walk.truth[14], config, 15);
-  const Eigen::Isometry3d T_new = Eigen::Isometry3d::Identity();  // the new integration
-  test::AllocationScope scope;
-  auto reloc = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search);
-  EXPECT_EQ(scope.allocations(), 0u);
-  ASSERT_TRUE(reloc) << reloc.error().detail;
-  const Eigen::Isometry3d found = T_map_odom * reloc->T_odom_base;
-  EXPECT_LT((found.translation() - walk.truth[14].translation()).norm(), 0.05);
-  EXPECT_LT(Eigen::AngleAxisd(found.linear().transpose() * walk.truth[14].linear()).angle(), 0.01);
-  EXPECT_GT(reloc->candidates, 100u);
-  EXPECT_LE(reloc->registrations, search.registrations);
-  EXPECT_LT(reloc->fitness_m2, config.scan_match_max_fitness_m2);
-  // The map is untouched: same keyframes, same last pose.
-  EXPECT_EQ(g.keyframe_slots(), last + 1);
-  // Searching only where the robot is not (the stop point, no span, no sides or turns) fails.
-  RelocaliseSearch narrow;
-  narrow.T_odom_from = narrow.T_odom_to = walk.odometry[11];
-  narrow.lateral_m = 0;
-  narrow.yaw_rad = 0;
-  narrow.registrations = 1;
-  auto miss = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, narrow);
-  ASSERT_FALSE(miss);
-  EXPECT_EQ(miss.error().code, Errc::kNotConverged);
-  // The same narrow search with a reach (the robot's top speed times the downtime: it turned
-  // off the predicted line) finds it all the same, off the line, without allocating.
-  RelocaliseSearch reach = narrow;
-  reach.yaw_rad = search.yaw_rad;
-  reach.reach_m = 3.0;
-  reach.registrations = search.registrations;
-  test::AllocationScope reach_scope;
-  auto wide = mapper.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, reach);
-  EXPECT_EQ(reach_scope.allocations(), 0u);
-  ASSERT_TRUE(wide) << wide.error().detail;
-  EXPECT_TRUE(wide->wide);
-  const Eigen::Isometry3d found_wide = T_map_odom * wide->T_odom_base;
-  EXPECT_LT((found_wide.translation() - walk.truth[14].translation()).norm(), 0.05);
-  EXPECT_LT(Eigen::AngleAxisd(found_wide.linear().transpose() * walk.truth[14].linear()).angle(),
-            0.01);
-  // At the middle of the box room the scan aligns as well turned half round: off the predicted
-  // path that is an ambiguity, never an answer (the node then resumes on the robot's motion).
-  Eigen::Isometry3d T_middle = Pose(0.5 * kSx, 0.5 * kSy, 0.3);
-  T_middle.translation().z() = 0.5;
-  const Eigen::Vector3d middle_from_stop =
-      T_middle.translation() - (T_map_odom * walk.odometry[11]).translation();
-  RelocaliseSearch around = reach;
-  around.reach_m = middle_from_stop.head<2>().norm() + 1.0;
-  const auto middle_points = ScanAt(T_middle, config, 16);
-  auto twofold = mapper.Relocalise({middle_points, times, 23.9, 24.0}, T_new, T_new, around);
-  ASSERT_FALSE(twofold);
-  EXPECT_EQ(twofold.error().code, Errc::kNotConverged);
-  EXPECT_NE(std::string(twofold.error().detail).find("ambiguous"), std::string::npos)
-      << twofold.error().detail;
-  // Without a keyframe there is nothing to relocalise against.
-  LocalMapper empty;
-  ASSERT_TRUE(empty.Init(config));
-  EXPECT_EQ(empty.Relocalise({points, times, 23.9, 24.0}, T_new, T_new, search).error().code,
-            Errc::kNotFound);
-}
-
-INSTANTIATE_TEST_SUITE_P(LocalMapper, Relocalisation, ::testing::Values(0.0, 1.0, 2.0, 3.0));
 
 // Four laps of the room with a keyframe store for a third of them: loop closures every few
 // keyframes once the path is 10 m long, so that soon every keyframe the graph could sparsify

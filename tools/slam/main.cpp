@@ -37,10 +37,9 @@
 #include <vector>
 
 #include "msgraphs/core/slam/local_mapper.hpp"
-#include "msgraphs/drivers/can_odometry/candump_file.hpp"
-#include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/velodyne/recorded_scans.hpp"
 #include "msgraphs/tools/ate.hpp"
+#include "msgraphs/tools/candump_odometry.hpp"
 #include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
@@ -270,32 +269,16 @@ int main(int argc, char** argv) {
   rusage after_init{};
   getrusage(RUSAGE_SELF, &after_init);
   auto scans = drivers::velodyne::RecordedScans::Open((dir / "velodyne.pcap").string());
-  auto candump = drivers::can_odometry::CandumpFileReader::Open((dir / "odometry.log").c_str());
+  auto candump = tools::CandumpOdometry::Open((dir / "odometry.log").c_str());
   if (!scans || !candump) {
     std::fprintf(stderr, "slam: cannot open the recording in %s\n", dir.c_str());
     return 1;
   }
-  auto odometry = drivers::can_odometry::OdometryStream::Create({}).value();
-  drivers::can_odometry::CandumpLine line;
-  bool odometry_done = false;
-  auto feed_odometry_until = [&](double t) {
-    while (!odometry_done && mapper.odometry().newest_stamp() < t) {
-      auto next = candump->Next(line);
-      if (!next || !*next) {
-        odometry_done = true;
-        break;
-      }
-      if (!odometry.Add(line.frame, line.stamp)) continue;
-      const auto& p = odometry.pose();
-      const auto& P = p.T_odom_base;
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      T.linear() = Eigen::Quaterniond(P.qw, P.qx, P.qy, P.qz).normalized().toRotationMatrix();
-      T.translation() = Eigen::Vector3d(P.x_m, P.y_m, P.z_m);
-      static_cast<void>(mapper.AddOdometry(p.stamp.seconds_since_epoch(), T));
-    }
+  const auto to_mapper = [&](double stamp_s, const Eigen::Isometry3d& T_odom_base) {
+    static_cast<void>(mapper.AddOdometry(stamp_s, T_odom_base));
   };
   if (odometry_from_truth) {
-    odometry_done = true;  // the encoders are not read
+    candump->Stop();  // the encoders are not read
     for (const tools::StampedPose& p : truth_as_odometry) static_cast<void>(mapper.AddOdometry(p.t, p.T));
   }
   std::vector<Eigen::Vector3f> points;
@@ -322,7 +305,7 @@ int main(int argc, char** argv) {
           t_start + std::chrono::duration_cast<Clock::duration>(
                         std::chrono::duration<double>((view.end_s - first_end_s) / speed)));
     }
-    feed_odometry_until(view.end_s + 0.05);
+    candump->Until(view.end_s + 0.05, to_mapper);
     const auto loops_before = mapper.loop_closer().stats().accepted;
     const auto rejected_before = mapper.loop_closer().stats().rejected_after_solve;
     const auto sweep_start = Clock::now();

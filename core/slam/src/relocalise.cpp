@@ -96,6 +96,43 @@ double LocalMapper::SeedScore(const Eigen::Isometry3d& T_last_seed) const {
   return score;
 }
 
+double LocalMapper::SeenThroughFraction(const Eigen::Isometry3d& T_last_candidate) const {
+  // Negative evidence: a return where the map's keyframes saw through. Only returns higher than
+  // the sensor (and below the grid's obstacle band's top) count, and only in cells that rays
+  // descending from the sensor crossed: a thing standing on the floor and reaching above the
+  // sensor would have stopped such a ray, whereas one lower than the sensor (a box, a table)
+  // may lie under rays that passed over it (in a construction site's boxes every right answer
+  // had up to 9 % of its band returns "seen through" when every free cell counted). The cell's
+  // neighbours must be crossed too and never hit: they absorb a cell of misalignment and walls
+  // that grazing rays crossed.
+  const Eigen::Isometry3d T_map = graph_.keyframe_pose(last_keyframe_) * T_last_candidate;
+  // Heights above the floor under the candidate, in the map (the base may be tilted: at 3
+  // degrees a return 8 m away is 0.4 m higher or lower than the base frame says).
+  const double floor_z = T_map.translation().z() - config_.base_height_m;
+  const double low_m = (T_map * config_.T_base_lidar).translation().z() - floor_z + 0.1;
+  const auto high_m = static_cast<double>(config_.grid.obstacle_max_height_m);
+  const std::size_t stride = std::max<std::size_t>(1, down_.size() / 2000);
+  std::size_t band = 0, seen_through = 0;
+  for (std::size_t k = 0; k < down_.size(); k += stride) {
+    const Eigen::Vector3d q = T_map * down_[k].cast<double>();
+    const double height_m = q.z() - floor_z;
+    if (height_m < low_m || height_m > high_m) continue;
+    ++band;
+    int x = 0, y = 0;
+    if (!grid_.ToCell(q.head<2>(), x, y)) continue;
+    bool through = true;
+    for (int dy = -1; dy <= 1 && through; ++dy) {
+      for (int dx = -1; dx <= 1 && through; ++dx) {
+        through = grid_.state(x + dx, y + dy) == FreeSpaceGrid::Cell::kFree &&
+                  !grid_.ever_occupied(x + dx, y + dy) &&
+                  grid_.clear_below_sensor(x + dx, y + dy, 2);
+      }
+    }
+    if (through) ++seen_through;
+  }
+  return band > 0 ? static_cast<double>(seen_through) / static_cast<double>(band) : 0.0;
+}
+
 Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
                                                  const Eigen::Isometry3d& T_new_start,
                                                  const Eigen::Isometry3d& T_new_end,
@@ -105,6 +142,7 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
       !std::isfinite(scan.end_s) || scan.end_s < scan.start_s || !(search.step_m > 0) ||
       !(search.lateral_m >= 0) || !(search.yaw_rad >= 0) || !(search.yaw_step_rad >= 0) ||
       !(search.reach_m >= 0) || !std::isfinite(search.reach_m) ||
+      !(search.max_seen_through >= 0) ||
       !search.T_odom_from.matrix().allFinite() || !search.T_odom_to.matrix().allFinite()) {
     return Error{Errc::kInvalidArgument, "relocalise: bad scan or search"};
   }
@@ -144,16 +182,17 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
   // thresholds wins, and only if no other place passes too: fitness does not tell a
   // corridor's look-alike stretches apart (a scan into space the map saw from afar fits worse
   // than one laid back onto the mapped corridor), so two places that both align are an
-  // ambiguity, not an answer (on the segment the search goes on within reach; the caller then
-  // resumes on the motion the robot had). The segment spans metres of corridor too: under
-  // load a node kept down 6 s took the stop point over the robot's place 6 m on.
+  // ambiguity, not an answer (the caller then resumes on the motion the robot had). The
+  // segment spans metres of corridor too: under load a node kept down 6 s took the stop point
+  // over the robot's place 6 m on.
   bool ambiguous = false;
+  // Every place that aligned and was not contradicted (a search ends when two differ).
+  std::array<Eigen::Isometry3d, 8> passed;
+  std::size_t passed_count = 0;
   const auto register_best = [&](const SeedRanking& ranking) {
     bool found = false;
     double best_fitness = config_.scan_match_max_fitness_m2;
     const double min_overlap = config_.scan_match_min_overlap * static_cast<double>(down_.size());
-    std::array<Eigen::Isometry3d, 8> passed;
-    std::size_t passed_count = 0;
     Eigen::Isometry3d T_last_best = Eigen::Isometry3d::Identity();
     for (std::size_t k = 0; k < ranking.size(); ++k) {
       auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_,
@@ -172,10 +211,19 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
           (at_map - from_map).head<2>().norm() > search.reach_m + search.step_m) {
         continue;
       }
+      // Negative evidence: fitness alone does not tell a look-alike place (a room turned
+      // round, the next room of a row) from the robot's, as its walls align too; but there
+      // the scan's walls stand where the map saw through (a doorway, a room beyond).
+      const double seen_through = SeenThroughFraction(result->T_target_source);
+      if (seen_through > search.max_seen_through) {
+        ++best.contradicted;
+        continue;
+      }
       if (passed_count < passed.size()) passed[passed_count++] = result->T_target_source;
       if (!(result->fitness < best_fitness)) continue;
       best_fitness = result->fitness;
       best.fitness_m2 = result->fitness;
+      best.seen_through = seen_through;
       T_last_best = result->T_target_source;
       best.T_odom_base = last_odometry_ * T_last_best;
       found = true;
@@ -218,10 +266,13 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
       }
     }
     if (register_best(ranking)) return best;
+    // Two places on the segment both align: a wider search could only pick one of them by
+    // how its seeds happened to rank.
+    if (ambiguous)
+      return Error{Errc::kNotConverged, "relocalise: places on the segment align alike (ambiguous)"};
   }
   if (search.reach_m <= 0) {
     if (!have_map) return Error{Errc::kDegenerate, "relocalise: no map near the search"};
-    if (ambiguous) return Error{Errc::kNotConverged, "relocalise: places on the segment align alike (ambiguous)"};
     return Error{Errc::kNotConverged, "relocalise: no seed aligned to the local map"};
   }
 
@@ -251,6 +302,9 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
   if (register_best(ranking)) return best;
   if (ambiguous)
     return Error{Errc::kNotConverged, "relocalise: places within reach align alike (ambiguous)"};
+  if (best.contradicted > 0)
+    return Error{Errc::kNotConverged,
+                 "relocalise: the places within reach that aligned contradict the map (walls where it saw through)"};
   return Error{Errc::kNotConverged, "relocalise: no seed within reach aligned to the map"};
 }
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "msgraphs/core/slam/restart_prediction.hpp"
 #include "msgraphs/platform/clock.hpp"
 #include "msgraphs/platform/realtime.hpp"
 #include "node_impl.hpp"
@@ -130,27 +131,12 @@ Node::Impl::Relocalising Node::Impl::RelocaliseOn(const ScanSlot& scan) {
                ? Relocalising::kWait
                : Relocalising::kSkipScan;
   }
-  // Where to look: from where the journal stopped, along the motion the robot had then (its
-  // last half second), for 1.5 times the time since (the robot may have slowed or stopped).
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();  // per half second, when it stopped
-  if (auto before = mapper.odometry().At(old_last_stamp_s - 0.5)) {
-    step = before->T_odom_base.inverse() * T_old_last;
-  }
-  // The last half second's motion kept for `seconds`, level (the base rocks).
-  const auto kept_on = [&](double seconds) {
-    const double k = std::clamp(seconds / 0.5, 0.0, 60.0);
-    const double yaw = std::atan2(step.linear()(1, 0), step.linear()(0, 0));
-    Eigen::Isometry3d ahead = Eigen::Isometry3d::Identity();
-    ahead.linear() = Eigen::AngleAxisd(k * yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    ahead.translation() << k * step.translation().x(), k * step.translation().y(), 0;
-    return T_old_last * ahead;
-  };
-  core::RelocaliseSearch search;
-  search.T_odom_from = T_old_last;
+  // Where to look: from where the journal stopped, along the motion the robot had then, and
+  // failing that anywhere it could have walked to at its top speed (core/slam/restart_prediction.hpp).
+  const core::RestartPrediction prediction(mapper.odometry(), T_old_last, old_last_stamp_s);
+  const core::RelocaliseSearch search =
+      prediction.Search(scan.end_s, config.relocalise_max_speed_mps);
   const double since_s = scan.end_s - old_last_stamp_s;
-  search.T_odom_to = kept_on(1.5 * since_s);
-  // Failing that, anywhere the robot could have walked to at its top speed.
-  search.reach_m = config.relocalise_max_speed_mps * std::max(since_s, 0.0);
   const SteadyTime t0 = platform::SteadyNow();
   core::LidarScanView view{scan.points, scan.time_offset_s, scan.start_s, scan.end_s};
   auto found = mapper.Relocalise(view, at_start->T_odom_base, at_end->T_odom_base, search);
@@ -173,7 +159,7 @@ Node::Impl::Relocalising Node::Impl::RelocaliseOn(const ScanSlot& scan) {
     // still walking; one that stood still had no motion to keep); scan matching then takes
     // up the rest within max_correction_m.
     const double down_s = std::max(0.0, new_odometry.stamp(0) - old_last_stamp_s);
-    T_odom_base_now = kept_on(down_s) * new_odometry.pose(0).inverse() * at_end->T_odom_base;
+    T_odom_base_now = prediction.KeptOn(down_s) * new_odometry.pose(0).inverse() * at_end->T_odom_base;
     std::printf("WARNING: relocalisation after the restart failed (%s); resuming %.1f s after "
                 "the last journaled pose with the motion the robot had then (%.2f m)\n",
                 found.error().detail, since_s,

@@ -271,6 +271,10 @@ struct RelocaliseSearch {
   double reach_m = 0;  ///< 0: the segment only
   /// Seeds scored within reach; the farthest rings are left out beyond.
   std::size_t max_reach_candidates = 400000;
+  /// An aligned place is refused when more than this fraction of the scan's wall returns lie
+  /// where the map saw through (LocalMapper::SeenThroughFraction). At the robot's place only
+  /// what moved since (people, a door) lies there; docs/runtime.md gives the measured spread.
+  double max_seen_through = 0.01;
 };
 
 struct Relocalisation {
@@ -279,6 +283,9 @@ struct Relocalisation {
   std::size_t candidates = 0;     ///< seeds scored
   std::size_t registrations = 0;  ///< of them registered
   bool wide = false;              ///< found by the search within reach, not on the segment
+  /// Of the scan's wall returns at the answer, the fraction where the map saw through.
+  double seen_through = 0;
+  std::size_t contradicted = 0;  ///< places that aligned but were refused by that test
 };
 
 class LocalMapper {
@@ -397,6 +404,7 @@ class LocalMapper {
   bool BuildMapFrom(std::uint32_t last, std::span<const std::uint32_t> keyframes);
   bool BuildMapNear(const Eigen::Vector2d& a_map, const Eigen::Vector2d& b_map, double radius_m);
   double SeedScore(const Eigen::Isometry3d& T_last_seed) const;
+  double SeenThroughFraction(const Eigen::Isometry3d& T_last_candidate) const;
   Matrix6d OdometryInformation(const Eigen::Isometry3d& delta, bool across_gap) const;
   enum class MatchOutcome : std::uint8_t { kAccepted, kFailed, kFitness, kOverlap, kDiverged };
   static const char* ToString(MatchOutcome outcome);
