@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -104,8 +105,7 @@ TEST_P(Relocalisation, AfterTheOdometryRestartedWhileTheRobotMoved) {
 INSTANTIATE_TEST_SUITE_P(LocalMapper, Relocalisation, ::testing::Values(0.0, 1.0, 2.0, 3.0));
 
 // The box room with a 1.2 m doorway in its wall at x = kSx (y 3.4-4.6 m, 2.2 m high) and, 3 m
-// beyond it, a wall seen only through the doorway (its points where the ray from the lidar
-// passes through the opening).
+// beyond it, a wall and a floor seen only through the doorway.
 constexpr double kDoorY0 = 3.4, kDoorY1 = 4.6, kDoorTop = 2.2, kBeyondX = kSx + 3.0;
 
 std::vector<Eigen::Vector3f> DoorwayScanAt(const Eigen::Isometry3d& T_world_base,
@@ -123,14 +123,16 @@ std::vector<Eigen::Vector3f> DoorwayScanAt(const Eigen::Isometry3d& T_world_base
     if (std::abs(p.x() - kSx) < 0.05 && in_doorway(p.y(), p.z())) continue;  // the opening
     out.push_back(p_lidar);
   }
-  // The wall beyond, where the lidar sees it through the opening.
-  for (const Eigen::Vector3f& q_lidar :
-       test::BoxRoom(kBeyondX, kSy, kSz, points / 2, 0.01, seed + 1000, T_lidar_world)) {
-    const Eigen::Vector3d q = T_world_lidar * q_lidar.cast<double>();
-    if (std::abs(q.x() - kBeyondX) > 0.05) continue;  // only the face at x = kBeyondX
-    const double t = (kSx - sensor.x()) / (q.x() - sensor.x());
-    const Eigen::Vector3d at_wall = sensor + t * (q - sensor);
-    if (in_doorway(at_wall.y(), at_wall.z())) out.push_back(q_lidar);
+  // Through the opening: rays from the lidar through points spread over it (some 600 a scan,
+  // about what a VLP-16 puts through a door 4 m away) to the floor or the wall beyond.
+  std::mt19937 rng(seed + 1000);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 600; ++k) {
+    const Eigen::Vector3d o(kSx, kDoorY0 + u(rng) * (kDoorY1 - kDoorY0), u(rng) * kDoorTop);
+    const Eigen::Vector3d ray = o - sensor;
+    double t = (kBeyondX - sensor.x()) / ray.x();
+    if (ray.z() < 0) t = std::min(t, -sensor.z() / ray.z());  // the floor beyond comes first
+    out.push_back((T_lidar_world * (sensor + t * ray)).cast<float>());
   }
   return out;
 }
@@ -153,16 +155,11 @@ TEST(Relocalisation, ADoorwayTellsTheRoomFromItselfTurnedHalfRound) {
   T_middle.translation().z() = 0.5;
   const auto points = DoorwayScanAt(T_middle, config, 77, 20000);
   const std::vector<float> times(points.size(), 0.1f);
-  RelocaliseSearch search;  // only within reach: nothing on a segment (no motion kept)
-  search.T_odom_from = search.T_odom_to = walk.odometry[14];
-  search.lateral_m = 0;
-  search.yaw_rad = 0;
-  search.registrations = 1;
-  const Eigen::Vector3d middle_from_stop =
-      T_middle.translation() - (T_map_odom * walk.odometry[14]).translation();
-  search.reach_m = middle_from_stop.head<2>().norm() + 1.0;
-  RelocaliseSearch wide = search;
-  wide.yaw_rad = 3.1416;
+  // Searched where the robot is, at every heading (seeds a step either side, no reach): the
+  // place turned half round is among them.
+  RelocaliseSearch wide;
+  wide.T_odom_from = wide.T_odom_to = T_map_odom.inverse() * T_middle;
+  wide.lateral_m = 0;
   wide.registrations = 6;
   const Eigen::Isometry3d T_new = Eigen::Isometry3d::Identity();
   test::AllocationScope scope;
