@@ -186,13 +186,13 @@ Expected<Relocalisation> LocalMapper::Relocalise(const LidarScanView& scan,
   // segment spans metres of corridor too: under load a node kept down 6 s took the stop point
   // over the robot's place 6 m on.
   bool ambiguous = false;
-  // Every place that aligned and was not contradicted (a search ends when two differ).
-  std::array<Eigen::Isometry3d, 8> passed;
-  std::size_t passed_count = 0;
   const auto register_best = [&](const SeedRanking& ranking) {
     bool found = false;
     double best_fitness = config_.scan_match_max_fitness_m2;
     const double min_overlap = config_.scan_match_min_overlap * static_cast<double>(down_.size());
+    // Every place that aligned and was not contradicted.
+    std::array<Eigen::Isometry3d, 8> passed;
+    std::size_t passed_count = 0;
     Eigen::Isometry3d T_last_best = Eigen::Isometry3d::Identity();
     for (std::size_t k = 0; k < ranking.size(); ++k) {
       auto result = vgicp_.Align(down_.span(), covariances_.span(), local_map_,
