@@ -14,11 +14,19 @@ void ExchangeKeyframes(Mission& mission, Robot& from) {
   KeyframeBaselineState& state = from.baseline;
   const core::SGraph& g = from.mapper.graph();
   const core::ScanContextConfig sc_config{20, 60, 20.0f, 0.5f};  // heights above the floor
-  for (std::uint32_t k = state.keyframes_sent; k < g.keyframe_slots(); ++k) {
+  // The keyframes made since the last exchange, in time order: sparsification frees slots and
+  // new keyframes take them, so "slots above the last one sent" would miss those.
+  for (std::uint32_t k = g.FirstKeyframe(); k != core::SGraph::kNoKeyframe; k = g.NextKeyframe(k)) {
+    if (g.keyframe_stamp(k) <= state.last_sent_stamp_s) continue;
+    state.last_sent_stamp_s = g.keyframe_stamp(k);
+    state.own_keyframes.erase(k);  // a sparsified keyframe's descriptor, if the slot is reused
     const auto cloud = from.mapper.keyframe_cloud(k);
     if (cloud.empty()) continue;
     core::ScanContext& sc = state.own_keyframes[k];
-    if (!sc.Build(cloud, sc_config)) continue;
+    if (!sc.Build(cloud, sc_config)) {
+      state.own_keyframes.erase(k);
+      continue;
+    }
     auto n = core::EncodeRoomDescriptor({from.id(), k, 0}, sc, mission.buffer);
     if (!n) continue;
     for (auto& to : mission.robots) {
@@ -29,10 +37,13 @@ void ExchangeKeyframes(Mission& mission, Robot& from) {
         ++mission.accounting.malformed;
         continue;
       }
+      // A reused slot is a new keyframe: it replaces the old one and is tried afresh.
       to->baseline.peer_keyframes[{from.index, k}] = {received, g.keyframe_pose(k)};
+      to->baseline.tried_keyframes.erase({from.index, k});
     }
   }
-  state.keyframes_sent = static_cast<std::uint32_t>(g.keyframe_slots());
+  // Keyframes sparsified since are no longer matched against.
+  std::erase_if(state.own_keyframes, [&](const auto& e) { return !g.keyframe_active(e.first); });
 }
 
 void MatchKeyframes(Mission& mission, Robot& a) {

@@ -99,10 +99,8 @@ void ProcessNextScan(Robot& r) {
 std::vector<StampedPose> Keyframes(const Robot& r) {
   std::vector<StampedPose> kf;
   const core::SGraph& g = r.mapper.graph();
-  for (std::uint32_t k = 0; k < g.keyframe_slots(); ++k) {
-    if (g.keyframe_active(k)) kf.push_back({g.keyframe_stamp(k), g.keyframe_pose(k)});
-  }
-  std::sort(kf.begin(), kf.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  for (std::uint32_t k = g.FirstKeyframe(); k != core::SGraph::kNoKeyframe; k = g.NextKeyframe(k))
+    kf.push_back({g.keyframe_stamp(k), g.keyframe_pose(k)});
   return kf;
 }
 

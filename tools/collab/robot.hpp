@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -29,7 +30,8 @@ namespace msgraphs::tools::collab {
 
 /// The keyframe-level baseline's state of one robot (keyframe_baseline.hpp).
 struct KeyframeBaselineState {
-  std::uint32_t keyframes_sent = 0;
+  /// The newest keyframe stamp sent (keyframes are walked in time order, not slot order).
+  double last_sent_stamp_s = -std::numeric_limits<double>::infinity();
   std::map<std::uint32_t, core::ScanContext> own_keyframes;
   /// Received: (sender index, keyframe) -> its descriptor and the sender's pose at the time.
   std::map<std::pair<int, std::uint32_t>, std::pair<core::ScanContext, Eigen::Isometry3d>>

@@ -352,14 +352,11 @@ int main(int argc, char** argv) {
   // Outputs.
   const core::SGraph& graph = mapper.graph();
   std::vector<tools::StampedPose> slam, encoders;
-  for (std::uint32_t k = 0; k < graph.keyframe_slots(); ++k) {
-    if (!graph.keyframe_active(k)) continue;
+  for (std::uint32_t k = graph.FirstKeyframe(); k != core::SGraph::kNoKeyframe;
+       k = graph.NextKeyframe(k)) {
     slam.push_back({graph.keyframe_stamp(k), graph.keyframe_pose(k)});
     encoders.push_back({graph.keyframe_stamp(k), mapper.keyframe_odometry(k)});
   }
-  auto by_time = [](const tools::StampedPose& a, const tools::StampedPose& b) { return a.t < b.t; };
-  std::sort(slam.begin(), slam.end(), by_time);
-  std::sort(encoders.begin(), encoders.end(), by_time);
   if (!out_dir.empty()) {
     fs::create_directories(out_dir);
     static_cast<void>(tools::WriteTum((fs::path(out_dir) / "keyframes.tum").string(), slam));

@@ -514,6 +514,15 @@ Status SGraph::AddFloorRoom(std::uint32_t room) {
 }
 
 std::size_t SGraph::keyframe_slots() const { return impl_->keyframe_high_water; }
+std::uint32_t SGraph::FirstKeyframe() const {
+  const std::int32_t k = impl_->origin;
+  return k == kNone ? kNoKeyframe : static_cast<std::uint32_t>(k);
+}
+std::uint32_t SGraph::NextKeyframe(std::uint32_t id) const {
+  if (!impl_->ValidKeyframe(id)) return kNoKeyframe;
+  const std::int32_t k = impl_->keyframes[id].next;
+  return k == kNone ? kNoKeyframe : static_cast<std::uint32_t>(k);
+}
 bool SGraph::keyframe_active(std::uint32_t id) const { return impl_->ValidKeyframe(id); }
 Eigen::Isometry3d SGraph::keyframe_pose(std::uint32_t id) const {
   return id < impl_->keyframe_high_water ? impl_->Pose(id) : Eigen::Isometry3d::Identity();

@@ -220,8 +220,9 @@ void Node::Impl::WriteExports() {
     out << "FIX " << config.robot.value << '\n';
     std::int64_t previous = -1;
     const double chain_info[6] = {1e4, 1e4, 1e4, 1e5, 1e5, 1e5};  // 1 cm, 0.2 deg
-    for (std::uint32_t k = 0; k < graph.keyframe_slots(); ++k) {
-      if (!graph.keyframe_active(k)) continue;
+    // The chain joins keyframes neighbouring in time (slots are reused: not in slot order).
+    for (std::uint32_t k = graph.FirstKeyframe(); k != core::SGraph::kNoKeyframe;
+         k = graph.NextKeyframe(k)) {
       out << "VERTEX_SE3:QUAT " << kKeyframeBase + k << ' ';
       PutQuaternion(out, graph.keyframe_pose(k));
       out << '\n';

@@ -70,8 +70,9 @@ void Node::Impl::WriteOutputs() {
   const core::SGraph& graph = mapper.graph();
   write("keyframes.tum", [&](std::ostream& out) {
     out << "# robot " << config.robot.value << " keyframes in its map frame: t x y z qx qy qz qw\n";
-    for (std::uint32_t k = 0; k < graph.keyframe_slots(); ++k) {
-      if (!graph.keyframe_active(k)) continue;
+    // In time order: sparsification reuses slots, so slot order is not.
+    for (std::uint32_t k = graph.FirstKeyframe(); k != core::SGraph::kNoKeyframe;
+         k = graph.NextKeyframe(k)) {
       out << std::fixed << graph.keyframe_stamp(k) << ' ';
       out.unsetf(std::ios::fixed);
       PutPose(out, graph.keyframe_pose(k));
@@ -205,6 +206,12 @@ void Node::Impl::PrintReport() {
           " run by the solver thread, %" PRIu64 " waited for at their keyframe; loop closures %" PRIu64 "\n",
           ms.full_solves, config.mapper.full_solve_lag_keyframes, ms.full_solves_background,
           solver.runs(), ms.full_solves_waited, ms.loop_closures);
+  const core::SGraphStats gs = mapper.graph().stats();
+  Appendf(text,
+          "  graph: %zu keyframes (peak %zu of max_keyframes %zu), %zu sparsified, %" PRIu64
+          " refused (store full); %zu factors\n",
+          gs.keyframes, gs.keyframes_peak, mapper.graph().config().max_keyframes, gs.sparsified,
+          gs.rejected_keyframes, gs.factors);
   const core::CollabPublisherStats& ps = publisher.stats();
   Appendf(text,
           "  wall marginals: %" PRIu64 " computed (%" PRIu64 " failed), %" PRIu64

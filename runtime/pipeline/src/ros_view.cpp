@@ -4,7 +4,6 @@
 // and rooms come from the publisher (SLAM thread); the other robots' from the session, which the
 // collab thread owns: it refreshes a copy after each exchange and each Match that changed
 // something, and the SLAM thread reads the copy.
-#include <algorithm>
 #include <cmath>
 
 #include "msgraphs/platform/clock.hpp"
@@ -68,13 +67,11 @@ void Node::Impl::PublishRos() {
   v.cloud.clear();
   const core::SGraph& graph = mapper.graph();
   double newest = 0;
-  for (std::uint32_t k = 0; k < graph.keyframe_slots(); ++k) {
-    if (!graph.keyframe_active(k)) continue;
+  for (std::uint32_t k = graph.FirstKeyframe(); k != core::SGraph::kNoKeyframe;
+       k = graph.NextKeyframe(k)) {
     v.trajectory.push_back({graph.keyframe_stamp(k), graph.keyframe_pose(k)});
-    newest = std::max(newest, graph.keyframe_stamp(k));
+    newest = graph.keyframe_stamp(k);  // oldest first: the last is the newest
   }
-  std::sort(v.trajectory.begin(), v.trajectory.end(),
-            [](const auto& a, const auto& b) { return a.stamp_s < b.stamp_s; });
   v.stamp_s = newest;
   // The TF tree has one root: the alive robot with the lowest id publishes it.
   v.publish_tf = true;

@@ -289,6 +289,14 @@ class SGraph {
 
   // ---- state ----
   std::size_t keyframe_slots() const;  ///< ids handed out so far (active or sparsified)
+  /// The active keyframes in time order: FirstKeyframe() is the origin, NextKeyframe(k) the
+  /// active keyframe after k; kNoKeyframe when there is none (an empty graph, after the newest,
+  /// or k not active). Slot order is not time order: sparsification frees slots and the next
+  /// keyframes take them, so whatever needs time order (a trajectory file, a chain of edges,
+  /// "the keyframes since") walks this way.
+  static constexpr std::uint32_t kNoKeyframe = 0xFFFFFFFFu;
+  std::uint32_t FirstKeyframe() const;
+  std::uint32_t NextKeyframe(std::uint32_t id) const;
   bool keyframe_active(std::uint32_t id) const;
   Eigen::Isometry3d keyframe_pose(std::uint32_t id) const;
   double keyframe_stamp(std::uint32_t id) const;
