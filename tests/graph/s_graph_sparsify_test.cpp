@@ -235,6 +235,7 @@ struct MarginalsCase {
   bool strong_prev_hop = false;  // hop 1 -> 2 four times more informative: loops carried to 1
   bool cut_hop_into_3 = false;   // no odometry 2 -> 3: nothing to compose (3 hangs on its loop)
   std::uint32_t observer = 3;
+  bool remove_2_on_request = false;  // SGraph::RemoveKeyframe(2) once all nine are in
 };
 
 std::array<Eigen::Matrix3d, 3> ObserverPlaneMarginals(const MarginalsCase& c, SGraphStats& stats) {
@@ -276,6 +277,9 @@ std::array<Eigen::Matrix3d, 3> ObserverPlaneMarginals(const MarginalsCase& c, SG
             g.AddRelativePose(a, b, exact(a, b), information, RelativePoseKind::kLoopClosure));
       }
     }
+  }
+  if (c.remove_2_on_request) {
+    EXPECT_TRUE(g.RemoveKeyframe(2));
   }
   std::array<std::uint32_t, 3> planes{};
   const Eigen::Isometry3d& T = truth[observer];
@@ -353,6 +357,67 @@ TEST(SGraphSparsification, ComposedUncertaintyIsTheMarginalOfTheRemovedKeyframe)
       }
     }
   }
+}
+
+// SGraph::RemoveKeyframe is sparsification with the victim named: keyframe 2 removed on request
+// from a store with room leaves the graph that a full store leaves when it picks keyframe 2.
+TEST(SGraphSparsification, RemovingAKeyframeOnRequestIsSparsifyingIt) {
+  for (const bool loops : {false, true}) {
+    for (const std::uint32_t observer : {1u, 3u}) {
+      MarginalsCase full_store;
+      full_store.loops = loops;
+      full_store.observer = observer;
+      MarginalsCase on_request = full_store;
+      on_request.max_keyframes = 9;
+      on_request.remove_2_on_request = true;
+      SGraphStats a, b;
+      const auto sparsified = ObserverPlaneMarginals(full_store, a);
+      const auto removed = ObserverPlaneMarginals(on_request, b);
+      EXPECT_EQ(a.sparsified, 1u);
+      EXPECT_EQ(a.removed_keyframes, 0u);
+      EXPECT_EQ(b.sparsified, 0u);
+      EXPECT_EQ(b.removed_keyframes, 1u);
+      EXPECT_EQ(b.keyframes, a.keyframes);
+      EXPECT_EQ(b.sparsified_with_loops, a.sparsified_with_loops);
+      EXPECT_EQ(b.sparsify_carried, a.sparsify_carried);
+      EXPECT_EQ(b.relative_factors, a.relative_factors);
+      for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_LT((removed[i] - sparsified[i]).norm(), 1e-9 * sparsified[i].norm())
+            << "plane " << i << " seen from " << observer << (loops ? " with loops" : "");
+      }
+    }
+  }
+  // What is never removed: the origin, the local window, what is not there.
+  SGraphConfig config;
+  config.max_keyframes = 16;
+  config.local_window_keyframes = 3;
+  SGraph g;
+  ASSERT_TRUE(g.Init(config));
+  EXPECT_EQ(g.RemoveKeyframe(0).error().code, Errc::kNotFound);
+  for (std::uint32_t i = 0; i < 6; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation().x() = i;
+    ASSERT_TRUE(g.AddKeyframe(i, T));
+    if (i > 0) {
+      Eigen::Isometry3d Z = Eigen::Isometry3d::Identity();
+      Z.translation().x() = 1;
+      ASSERT_TRUE(g.AddRelativePose(i - 1, i, Z, OdometryInformation(), RelativePoseKind::kOdometry));
+    }
+  }
+  EXPECT_EQ(g.RemoveKeyframe(0).error().code, Errc::kInvalidArgument);  // the origin
+  for (std::uint32_t k : {3u, 4u, 5u})  // the window
+    EXPECT_EQ(g.RemoveKeyframe(k).error().code, Errc::kInvalidArgument) << k;
+  EXPECT_EQ(g.RemoveKeyframe(6).error().code, Errc::kNotFound);
+  EXPECT_EQ(g.stats().removed_keyframes, 0u);
+  EXPECT_TRUE(g.RemoveKeyframe(2));
+  EXPECT_EQ(g.RemoveKeyframe(2).error().code, Errc::kNotFound);  // once
+  EXPECT_TRUE(g.RemoveKeyframe(1));
+  EXPECT_EQ(g.stats().keyframes, 4u);
+  EXPECT_EQ(g.NextKeyframe(0), 3u);  // the chain joined over both
+  auto report = g.Solve(SolveKind::kFull);
+  ASSERT_TRUE(report);
+  EXPECT_TRUE(report->usable);
+  EXPECT_LT(std::fabs(g.keyframe_pose(3).translation().x() - 3.0), 1e-9);
 }
 
 // A patrol: laps of the room's ellipse (24 keyframes a lap, 0.57 m apart) on drifting odometry.

@@ -467,6 +467,12 @@ struct SGraph::Impl {
   // keyframe lies between the origin and the local window, which the config's validation rules
   // out; AddKeyframe then refuses the keyframe rather than write past the store.
   bool Sparsify();
+  // Removes keyframe v (active, between two keyframes): its loops carried to a neighbour, its
+  // neighbours joined by the composed hop, its plane observations dropped, its slot freed. The
+  // body of Sparsify once the victim is chosen; counts what it carries and drops, not itself.
+  void RemoveKeyframe(std::uint32_t v);
+  // The oldest keyframe of the local window (kNone when fewer keyframes than the window).
+  std::int32_t WindowStart() const;
   // A relative factor's measurement T_a_b and information, as its residual holds them.
   void RelativeMeasurement(const FactorRecord& f,
                            Eigen::Isometry3d& T_a_b,

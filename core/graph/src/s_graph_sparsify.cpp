@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// S-Graph sparsification: one keyframe out when the keyframe store is full (docs/s-graph.md).
+// S-Graph sparsification: one keyframe out when the keyframe store is full (docs/s-graph.md),
+// or the one a caller names (SGraph::RemoveKeyframe).
 //
 // The victim's neighbours p and n are joined by the composition of its two chain hops, and every
 // other relative factor on it (a loop closure) is carried to a neighbour through the hop that
@@ -111,12 +112,17 @@ bool SGraph::Impl::AddOrFuseRelative(std::uint32_t from,
   return static_cast<bool>(AddRelative(from, to, T_from_to, information, kind));
 }
 
-bool SGraph::Impl::Sparsify() {
-  if (origin == kNone || newest == kNone) return false;
+std::int32_t SGraph::Impl::WindowStart() const {
   std::int32_t window_start = newest;
   for (std::size_t i = 1; i < config.local_window_keyframes && window_start != kNone; ++i) {
     window_start = keyframes[static_cast<std::size_t>(window_start)].prev;
   }
+  return window_start;
+}
+
+bool SGraph::Impl::Sparsify() {
+  if (origin == kNone || newest == kNone) return false;
+  const std::int32_t window_start = WindowStart();
   if (window_start == kNone) return false;
   // The victim, cheapest loss first: no loop closure on it; then loops that can be carried
   // (a hop with a measurement to carry them through), fewest first; then the rest. Within
@@ -149,7 +155,14 @@ bool SGraph::Impl::Sparsify() {
     }
   }
   if (victim == kNone) return false;
-  const auto v = static_cast<std::uint32_t>(victim);
+  RemoveKeyframe(static_cast<std::uint32_t>(victim));
+  ++stats.sparsified;
+  return true;
+}
+
+void SGraph::Impl::RemoveKeyframe(std::uint32_t v) {
+  MSGRAPHS_ASSERT(ValidKeyframe(v) && keyframes[v].prev != kNone && keyframes[v].next != kNone,
+                  "only a keyframe between two others is removed");
   const auto p = static_cast<std::uint32_t>(keyframes[v].prev);
   const auto n = static_cast<std::uint32_t>(keyframes[v].next);
   const bool had_loops = keyframes[v].loop_factors > 0;
@@ -234,9 +247,8 @@ bool SGraph::Impl::Sparsify() {
   keyframes[p].next = static_cast<std::int32_t>(n);
   keyframes[n].prev = static_cast<std::int32_t>(p);
   keyframes[n].information_from_prev.setZero();
-  free_keyframe_slots.push_back(victim);  // capacity reserved at Init: no allocation
+  free_keyframe_slots.push_back(static_cast<std::int32_t>(v));  // reserved at Init: no allocation
   --active_keyframes;
-  ++stats.sparsified;
   if (had_loops) ++stats.sparsified_with_loops;
   // 4. Join the neighbours: Z = A B, Sigma = Ad(B^-1) uses_a Sigma_a Ad(B^-1)^T + uses_b Sigma_b.
   //    Without a measurement on one side the chain was already cut there: nothing to join.
@@ -249,7 +261,25 @@ bool SGraph::Impl::Sparsify() {
       ++stats.sparsify_dropped;
     }
   }
-  return true;
+}
+
+Status SGraph::RemoveKeyframe(std::uint32_t id) {
+  Impl& m = *impl_;
+  if (!m.ValidKeyframe(id)) return Error{Errc::kNotFound, "no such keyframe"};
+  if (static_cast<std::int32_t>(id) == m.origin)
+    return Error{Errc::kInvalidArgument, "the origin holds the gauge: never removed"};
+  // The local window: the newest keyframes, which the local solve moves (and the newest has no
+  // successor to join to).
+  const std::int32_t window_start = m.WindowStart();
+  for (std::int32_t k = m.newest; k != kNone; k = m.keyframes[static_cast<std::size_t>(k)].prev) {
+    if (static_cast<std::uint32_t>(k) == id)
+      return Error{Errc::kInvalidArgument, "a keyframe in the local window is not removed"};
+    if (k == window_start) break;
+  }
+  ++m.stats.revision;  // every call that may change the graph
+  m.RemoveKeyframe(id);
+  ++m.stats.removed_keyframes;
+  return Ok();
 }
 
 }  // namespace msgraphs::core

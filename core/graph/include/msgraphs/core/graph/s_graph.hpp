@@ -152,6 +152,8 @@ struct SGraphStats {
   /// sparsifications that found nothing to remove. Both stay 0 under a validated config (a
   /// keyframe always lies between the origin and the local window); never a write past the store.
   std::uint64_t rejected_keyframes = 0, sparsify_failed = 0;
+  /// Keyframes removed on request (RemoveKeyframe), not counted in `sparsified`.
+  std::uint64_t removed_keyframes = 0;
   std::size_t planes = 0, rooms = 0, floors = 0;
   std::size_t factors = 0, factors_peak = 0;
   std::array<std::size_t, 4> relative_factors{};  ///< by RelativePoseKind
@@ -215,6 +217,14 @@ class SGraph {
   Expected<double> FactorChi2(std::uint32_t factor) const;
   /// Removes a factor (a loop closure the rest of the graph contradicts).
   Status RemoveFactor(std::uint32_t factor);
+
+  /// Removes a keyframe as sparsification does (docs/s-graph.md): its loop closures carried to
+  /// a neighbour through the hop that leads there, its neighbours joined by the composition of
+  /// its two hops, its plane observations dropped, its slot freed for a later keyframe. For a
+  /// caller that knows the keyframe is redundant (a revisit of a place another keyframe keeps).
+  /// kNotFound for an inactive id; kInvalidArgument for the origin or a keyframe in the local
+  /// window. A background job begun before keeps what it borrowed (ApplyFullSolve skips it).
+  Status RemoveKeyframe(std::uint32_t id);
 
   /// A new plane landmark in the map frame (normal normalised here).
   Expected<std::uint32_t> AddPlane(const Eigen::Vector3d& normal_map,
