@@ -89,49 +89,6 @@ TEST(SGraphSparsification, KeepsTheGraphWithinCapacity) {
   }
 }
 
-// Sparsified keyframes free their slots and later keyframes take them, so slot order stops being
-// time order: the time-ordered walk must still give every active keyframe once, oldest first.
-TEST(SGraphSparsification, KeyframesAreWalkedInTimeOrderOnceSlotsAreReused) {
-  SGraphConfig config;
-  config.max_keyframes = 12;
-  config.local_window_keyframes = 4;
-  SGraph g;
-  ASSERT_TRUE(g.Init(config));
-  EXPECT_EQ(g.FirstKeyframe(), SGraph::kNoKeyframe);
-  const Room room;
-  const Walk walk(room, 60);
-  std::uint32_t prev = 0;
-  for (std::size_t i = 0; i < walk.truth.size(); ++i) {
-    const std::uint32_t k = *g.AddKeyframe(static_cast<double>(i), walk.truth[i]);
-    if (i > 0) {
-      ASSERT_TRUE(g.AddRelativePose(prev, k, walk.odometry[i - 1].inverse() * walk.odometry[i],
-                                    OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-    prev = k;
-    std::size_t walked = 0;
-    double last_stamp = -1;
-    for (std::uint32_t w = g.FirstKeyframe(); w != SGraph::kNoKeyframe; w = g.NextKeyframe(w)) {
-      ASSERT_TRUE(g.keyframe_active(w));
-      ASSERT_GT(g.keyframe_stamp(w), last_stamp) << "after " << i << " keyframes";
-      last_stamp = g.keyframe_stamp(w);
-      ++walked;
-    }
-    ASSERT_EQ(walked, g.stats().keyframes);
-    EXPECT_EQ(last_stamp, static_cast<double>(i));  // the newest is last
-  }
-  EXPECT_EQ(g.keyframe_stamp(g.FirstKeyframe()), 0.0);  // the origin is first
-  // The walk was tested where it matters: some slot holds a newer keyframe than a later slot.
-  bool slot_order_is_time_order = true;
-  for (std::uint32_t k = 1; k < g.keyframe_slots(); ++k) {
-    if (g.keyframe_active(k - 1) && g.keyframe_active(k) &&
-        g.keyframe_stamp(k - 1) > g.keyframe_stamp(k))
-      slot_order_is_time_order = false;
-  }
-  EXPECT_FALSE(slot_order_is_time_order);
-  // A sparsified slot not yet reused, or one past the slots handed out, has no successor.
-  EXPECT_EQ(g.NextKeyframe(static_cast<std::uint32_t>(g.keyframe_slots())), SGraph::kNoKeyframe);
-}
-
 // Exact measurements (the truth's relative poses) along a path that climbs, rolls and pitches,
 // so that a wrong adjoint or a wrong direction shows; loops in both directions, some between
 // neighbours, so that every keyframe outside the local window soon carries one. The estimates
@@ -387,37 +344,6 @@ TEST(SGraphSparsification, RemovingAKeyframeOnRequestIsSparsifyingIt) {
       }
     }
   }
-  // What is never removed: the origin, the local window, what is not there.
-  SGraphConfig config;
-  config.max_keyframes = 16;
-  config.local_window_keyframes = 3;
-  SGraph g;
-  ASSERT_TRUE(g.Init(config));
-  EXPECT_EQ(g.RemoveKeyframe(0).error().code, Errc::kNotFound);
-  for (std::uint32_t i = 0; i < 6; ++i) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation().x() = i;
-    ASSERT_TRUE(g.AddKeyframe(i, T));
-    if (i > 0) {
-      Eigen::Isometry3d Z = Eigen::Isometry3d::Identity();
-      Z.translation().x() = 1;
-      ASSERT_TRUE(g.AddRelativePose(i - 1, i, Z, OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-  }
-  EXPECT_EQ(g.RemoveKeyframe(0).error().code, Errc::kInvalidArgument);  // the origin
-  for (std::uint32_t k : {3u, 4u, 5u})  // the window
-    EXPECT_EQ(g.RemoveKeyframe(k).error().code, Errc::kInvalidArgument) << k;
-  EXPECT_EQ(g.RemoveKeyframe(6).error().code, Errc::kNotFound);
-  EXPECT_EQ(g.stats().removed_keyframes, 0u);
-  EXPECT_TRUE(g.RemoveKeyframe(2));
-  EXPECT_EQ(g.RemoveKeyframe(2).error().code, Errc::kNotFound);  // once
-  EXPECT_TRUE(g.RemoveKeyframe(1));
-  EXPECT_EQ(g.stats().keyframes, 4u);
-  EXPECT_EQ(g.NextKeyframe(0), 3u);  // the chain joined over both
-  auto report = g.Solve(SolveKind::kFull);
-  ASSERT_TRUE(report);
-  EXPECT_TRUE(report->usable);
-  EXPECT_LT(std::fabs(g.keyframe_pose(3).translation().x() - 3.0), 1e-9);
 }
 
 // A patrol: laps of the room's ellipse (24 keyframes a lap, 0.57 m apart) on drifting odometry.

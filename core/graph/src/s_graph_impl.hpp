@@ -471,6 +471,9 @@ struct SGraph::Impl {
   // neighbours joined by the composed hop, its plane observations dropped, its slot freed. The
   // body of Sparsify once the victim is chosen; counts what it carries and drops, not itself.
   void RemoveKeyframe(std::uint32_t v);
+  // Whether removing v would carry every loop on it and join its neighbours (no constraint
+  // dropped): what a removal on request requires.
+  bool RemovalLosesNothing(std::uint32_t v) const;
   // The oldest keyframe of the local window (kNone when fewer keyframes than the window).
   std::int32_t WindowStart() const;
   // A relative factor's measurement T_a_b and information, as its residual holds them.

@@ -10,6 +10,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
@@ -118,6 +119,20 @@ std::int32_t SGraph::Impl::WindowStart() const {
     window_start = keyframes[static_cast<std::size_t>(window_start)].prev;
   }
   return window_start;
+}
+
+bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) const {
+  const auto p = static_cast<std::uint32_t>(keyframes[v].prev);
+  const auto n = static_cast<std::uint32_t>(keyframes[v].next);
+  const Hop a = MakeHop(keyframes[v]), b = MakeHop(keyframes[n]);
+  if (!a.usable || !b.usable) return false;  // nothing would join the neighbours
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!f.active || f.kind != FactorKind::kRelative || f.chain || (f.a != v && f.b != v))
+      continue;
+    if (Route(f.a == v ? f.b : f.a, p, n, a, b) == Via::kNowhere) return false;
+  }
+  return true;
 }
 
 bool SGraph::Impl::Sparsify() {
@@ -244,6 +259,7 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v) {
   RemoveBlock(node.t);
   node.active = false;
   node.loop_factors = 0;
+  node.prev = node.next = kNone;  // no longer in the time chain
   keyframes[p].next = static_cast<std::int32_t>(n);
   keyframes[n].prev = static_cast<std::int32_t>(p);
   keyframes[n].information_from_prev.setZero();
@@ -263,7 +279,7 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v) {
   }
 }
 
-Status SGraph::RemoveKeyframe(std::uint32_t id) {
+Status SGraph::RemoveKeyframe(std::uint32_t id, std::span<const std::uint32_t> keep_factors) {
   Impl& m = *impl_;
   if (!m.ValidKeyframe(id)) return Error{Errc::kNotFound, "no such keyframe"};
   if (static_cast<std::int32_t>(id) == m.origin)
@@ -276,6 +292,17 @@ Status SGraph::RemoveKeyframe(std::uint32_t id) {
       return Error{Errc::kInvalidArgument, "a keyframe in the local window is not removed"};
     if (k == window_start) break;
   }
+  // A carried loop is a new factor (a new id): a loop still to be judged by its id must keep
+  // its keyframe.
+  for (const std::uint32_t f : keep_factors) {
+    if (f < m.factor_high_water && m.factors[f].active && m.factors[f].kind == FactorKind::kRelative &&
+        (m.factors[f].a == id || m.factors[f].b == id))
+      return Error{Errc::kInvalidArgument, "a factor the caller keeps ends at the keyframe"};
+  }
+  // Sparsification at a full store takes what it must, losing a loop or cutting the chain if
+  // nothing better is left; a removal on request never does.
+  if (!m.RemovalLosesNothing(id))
+    return Error{Errc::kInvalidArgument, "removing the keyframe would lose a constraint"};
   ++m.stats.revision;  // every call that may change the graph
   m.RemoveKeyframe(id);
   ++m.stats.removed_keyframes;

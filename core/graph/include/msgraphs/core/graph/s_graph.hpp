@@ -141,11 +141,12 @@ struct SGraphSolveReport {
 
 struct SGraphStats {
   std::size_t keyframes = 0, keyframes_peak = 0, sparsified = 0;
-  // Sparsification when loops are everywhere (docs/s-graph.md): victims that carried a loop
-  // closure (taken only when no keyframe without one was left), relative factors carried from a
-  // victim to a neighbour through the composed hop, of them fused into a parallel factor already
-  // there, and constraints that could not be carried over (a hop without a measurement, a
-  // composition that is not positive definite, a full factor store): counted, and lost.
+  // Keyframes removed (sparsified, or on request: RemoveKeyframe) that carried a loop closure
+  // (sparsification takes one only when no keyframe without one was left), relative factors
+  // carried from a removed keyframe to a neighbour through the composed hop, of them fused into
+  // a parallel factor already there, and constraints that could not be carried over (a hop
+  // without a measurement, a composition that is not positive definite, a full factor store):
+  // counted, and lost (sparsification at a full store only; docs/s-graph.md).
   std::size_t sparsified_with_loops = 0, sparsify_carried = 0, sparsify_merged = 0,
               sparsify_dropped = 0;
   /// Keyframes refused because the store was full and nothing could be sparsified, and
@@ -222,9 +223,14 @@ class SGraph {
   /// a neighbour through the hop that leads there, its neighbours joined by the composition of
   /// its two hops, its plane observations dropped, its slot freed for a later keyframe. For a
   /// caller that knows the keyframe is redundant (a revisit of a place another keyframe keeps).
-  /// kNotFound for an inactive id; kInvalidArgument for the origin or a keyframe in the local
-  /// window. A background job begun before keeps what it borrowed (ApplyFullSolve skips it).
-  Status RemoveKeyframe(std::uint32_t id);
+  /// A carried loop is a new factor with a new id: a caller that holds loop factor ids (loops
+  /// still to be judged) passes them as `keep_factors`, and a keyframe one of them ends at is
+  /// kept. kNotFound for an inactive id; kInvalidArgument for the origin, a keyframe in the
+  /// local window, one a kept factor ends at, or one whose removal would lose a constraint (a
+  /// loop with no hop to carry it, a hop without a measurement): unlike sparsification at a
+  /// full store, a removal on request never drops anything. A background job begun before
+  /// keeps what it borrowed (ApplyFullSolve skips the keyframe).
+  Status RemoveKeyframe(std::uint32_t id, std::span<const std::uint32_t> keep_factors = {});
 
   /// A new plane landmark in the map frame (normal normalised here).
   Expected<std::uint32_t> AddPlane(const Eigen::Vector3d& normal_map,
