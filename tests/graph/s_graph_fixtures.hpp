@@ -66,6 +66,14 @@ inline Matrix6d OdometryInformation() {
   return info;
 }
 
+// A loop closure's information: 2 cm, 0.23 degrees.
+inline Matrix6d LoopInformation() {
+  Matrix6d info = Matrix6d::Zero();
+  info.diagonal() << Eigen::Vector3d::Constant(1 / (0.02 * 0.02)),
+      Eigen::Vector3d::Constant(1 / (0.004 * 0.004));
+  return info;
+}
+
 // A robot walking laps of an ellipse inside the room, with drifting odometry (scale +3 %,
 // yaw +0.17 degrees per step: about Spot's 1 degree per 10 m, exaggerated threefold).
 struct Walk {

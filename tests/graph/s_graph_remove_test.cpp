@@ -17,11 +17,29 @@ namespace {
 
 using namespace sgraph_test;  // NOLINT(google-build-using-namespace): test fixtures
 
-Matrix6d LoopInformation() {
-  Matrix6d info = Matrix6d::Zero();
-  info.diagonal() << Eigen::Vector3d::Constant(1 / (0.02 * 0.02)),
-      Eigen::Vector3d::Constant(1 / (0.004 * 0.004));
-  return info;
+// A store of 16 with a local window of 3.
+SGraphConfig SmallStore() {
+  SGraphConfig config;
+  config.max_keyframes = 16;
+  config.local_window_keyframes = 3;
+  return config;
+}
+
+// Keyframes 0..count-1 a metre apart along x, chained by exact odometry except into keyframe
+// `cut` (no measurement there; 0: none cut). Keyframes from `aside_from` on start 0.3 m aside
+// in y.
+void StraightLine(SGraph& g, std::uint32_t count, std::uint32_t cut, std::uint32_t aside_from) {
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  step.translation().x() = 1;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() << i, i >= aside_from ? 0.3 : 0.0, 0;
+    ASSERT_TRUE(g.AddKeyframe(i, T));
+    if (i > 0 && i != cut) {
+      ASSERT_TRUE(
+          g.AddRelativePose(i - 1, i, step, OdometryInformation(), RelativePoseKind::kOdometry));
+    }
+  }
 }
 
 // Sparsified keyframes free their slots and later keyframes take them, so slot order stops being
@@ -79,23 +97,10 @@ TEST(SGraphKeyframes, AreWalkedInTimeOrderOnceSlotsAreReused) {
 TEST(SGraphRemoveKeyframe, NeverTheOriginOrTheWindowAndTheChainIsJoined) {
   // Estimates start off the truth (keyframes 3-5 0.3 m aside): only a joined chain brings them
   // back.
-  SGraphConfig config;
-  config.max_keyframes = 16;
-  config.local_window_keyframes = 3;
   SGraph g;
-  ASSERT_TRUE(g.Init(config));
+  ASSERT_TRUE(g.Init(SmallStore()));
   EXPECT_EQ(g.RemoveKeyframe(0).error().code, Errc::kNotFound);
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  step.translation().x() = 1;
-  for (std::uint32_t i = 0; i < 6; ++i) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation() << i, i >= 3 ? 0.3 : 0.0, 0;
-    ASSERT_TRUE(g.AddKeyframe(i, T));
-    if (i > 0) {
-      ASSERT_TRUE(
-          g.AddRelativePose(i - 1, i, step, OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(StraightLine(g, 6, 0, 3));
   EXPECT_EQ(g.RemoveKeyframe(0).error().code, Errc::kInvalidArgument);  // the origin
   for (std::uint32_t k : {3u, 4u, 5u}) {  // the window
     EXPECT_EQ(g.RemoveKeyframe(k).error().code, Errc::kInvalidArgument) << k;
@@ -123,24 +128,11 @@ TEST(SGraphRemoveKeyframe, NeverTheOriginOrTheWindowAndTheChainIsJoined) {
 }
 
 // A removal on request never loses a constraint, and keeps the keyframes of loops the caller
-// still has to judge (a carried loop is a new factor, with a new id).
+// still has to judge (a carried loop is another factor: it may take another id or be fused).
 TEST(SGraphRemoveKeyframe, LosesNothing) {
-  SGraphConfig config;
-  config.max_keyframes = 16;
-  config.local_window_keyframes = 3;
   SGraph g;
-  ASSERT_TRUE(g.Init(config));
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  step.translation().x() = 1;
-  for (std::uint32_t i = 0; i < 7; ++i) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation().x() = i;
-    ASSERT_TRUE(g.AddKeyframe(i, T));
-    if (i > 0 && i != 3) {  // no measurement from 2 to 3: the chain is cut there
-      ASSERT_TRUE(
-          g.AddRelativePose(i - 1, i, step, OdometryInformation(), RelativePoseKind::kOdometry));
-    }
-  }
+  ASSERT_TRUE(g.Init(SmallStore()));
+  ASSERT_NO_FATAL_FAILURE(StraightLine(g, 7, 3, 7));  // no measurement from 2 to 3: cut there
   Eigen::Isometry3d two = Eigen::Isometry3d::Identity();
   two.translation().x() = 2;
   const auto loop = g.AddRelativePose(1, 3, two, LoopInformation(), RelativePoseKind::kLoopClosure);

@@ -22,13 +22,6 @@ namespace {
 
 using namespace sgraph_test;  // NOLINT(google-build-using-namespace): test fixtures
 
-Matrix6d LoopInformation() {
-  Matrix6d info = Matrix6d::Zero();
-  info.diagonal() << Eigen::Vector3d::Constant(1 / (0.02 * 0.02)),
-      Eigen::Vector3d::Constant(1 / (0.004 * 0.004));
-  return info;
-}
-
 // The truth index of a keyframe (the tests stamp keyframe i with i).
 std::size_t TruthIndex(const SGraph& g, std::uint32_t keyframe) {
   return static_cast<std::size_t>(std::lround(g.keyframe_stamp(keyframe)));

@@ -292,8 +292,8 @@ Status SGraph::RemoveKeyframe(std::uint32_t id, std::span<const std::uint32_t> k
       return Error{Errc::kInvalidArgument, "a keyframe in the local window is not removed"};
     if (k == window_start) break;
   }
-  // A carried loop is a new factor (a new id): a loop still to be judged by its id must keep
-  // its keyframe.
+  // A carried loop is another factor (another id, or fused): a loop still to be judged by its
+  // id must keep its keyframe.
   for (const std::uint32_t f : keep_factors) {
     if (f < m.factor_high_water && m.factors[f].active && m.factors[f].kind == FactorKind::kRelative &&
         (m.factors[f].a == id || m.factors[f].b == id))

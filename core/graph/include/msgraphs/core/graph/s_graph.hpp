@@ -223,9 +223,9 @@ class SGraph {
   /// a neighbour through the hop that leads there, its neighbours joined by the composition of
   /// its two hops, its plane observations dropped, its slot freed for a later keyframe. For a
   /// caller that knows the keyframe is redundant (a revisit of a place another keyframe keeps).
-  /// A carried loop is a new factor with a new id: a caller that holds loop factor ids (loops
-  /// still to be judged) passes them as `keep_factors`, and a keyframe one of them ends at is
-  /// kept. kNotFound for an inactive id; kInvalidArgument for the origin, a keyframe in the
+  /// A carried loop is another factor (it may take another id, or be fused into a parallel
+  /// one), so a caller that holds loop factor ids (loops still to be judged) passes them as
+  /// `keep_factors`, and a keyframe one of them ends at is kept. kNotFound for an inactive id; kInvalidArgument for the origin, a keyframe in the
   /// local window, one a kept factor ends at, or one whose removal would lose a constraint (a
   /// loop with no hop to carry it, a hop without a measurement): unlike sparsification at a
   /// full store, a removal on request never drops anything. A background job begun before
