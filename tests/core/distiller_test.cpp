@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <thread>
@@ -29,6 +30,7 @@ struct OneRoom {
   PlaneMapper planes;
   Eigen::Isometry3d T_room = test::PlanarPose(2, 3, 0.3);
   std::vector<std::uint32_t> walls, keyframes;
+  double step_m = 0.5;  // along the room's x, from 0.5 m short of its centre
 
   OneRoom() {
     EXPECT_TRUE(graph.Init(config));
@@ -43,7 +45,7 @@ struct OneRoom {
   }
   void AddKeyframe() {
     const int k = static_cast<int>(keyframes.size());
-    const Eigen::Isometry3d T = T_room * test::PlanarPose(0.5 * k - 0.5, 0.2, 0.1 * k);
+    const Eigen::Isometry3d T = T_room * test::PlanarPose(step_m * k - 0.5, 0.2, 0.1 * k);
     const std::uint32_t kf = *graph.AddKeyframe(k, T);
     if (k > 0) {
       ASSERT_TRUE(graph.AddRelativePose(keyframes.back(), kf,
@@ -108,6 +110,48 @@ TEST(Distiller, SharesWallsWithCovariancesAndRoomsOnlyWhenChanged) {
     EXPECT_EQ(scope.allocations(), 0u);
   }
   EXPECT_EQ(plain.graph().walls.size(), 4u);
+}
+
+// A wall whose observers were all sparsified away has no marginal (Ceres would call it
+// certain): it is held back and counted, and the others' marginals still come.
+TEST(Distiller, HoldsBackAWallNothingMeasuresAnyMore) {
+  OneRoom f;
+  f.config.max_keyframes = 8;
+  f.config.local_window_keyframes = 2;
+  f.step_m = 0.25;  // 12 keyframes inside the room
+  ASSERT_TRUE(f.graph.Init(f.config));
+  // Every keyframe also sees a wall of its own (parallel to wall 0, further out), so a full
+  // store must take some wall's last observer.
+  std::vector<std::uint32_t> own;
+  for (int k = 0; k < 12; ++k) {
+    ASSERT_NO_FATAL_FAILURE(f.AddKeyframe());
+    const auto [n, d0] = f.Wall(0);
+    const double d = d0 + 1.0 + k;
+    own.push_back(*f.graph.AddPlane(n, d, PlaneClass::kWall));
+    const Eigen::Isometry3d T = f.graph.keyframe_pose(f.keyframes.back());
+    PlaneMeasurement z;
+    z.normal = T.linear().transpose() * n;
+    z.d = d + n.dot(T.translation());
+    WallBasis(z.normal, z.basis_u, z.basis_v);
+    z.covariance = Eigen::Matrix3d::Identity() * 1e-4;
+    ASSERT_TRUE(f.graph.AddPlaneObservation(f.keyframes.back(), own.back(), z));
+  }
+  ASSERT_GT(f.graph.stats().planes_unobserved, 0u);
+  DistillerConfig config;
+  config.min_wall_observations = 1;  // share the single-observation walls too
+  Distiller distiller;
+  ASSERT_TRUE(distiller.Init(1, f.config, config));
+  ASSERT_TRUE(distiller.Update(f.graph, f.planes));
+  EXPECT_EQ(distiller.stats().walls_unobserved, f.graph.stats().planes_unobserved);
+  EXPECT_EQ(distiller.stats().marginal_failures, 0u);
+  std::size_t shared_own = 0;
+  for (const DistilledWall& w : distiller.graph().walls) {
+    EXPECT_GT(f.graph.plane(w.id).live_observations, 0u) << "wall " << w.id;
+    EXPECT_GT(w.covariance.diagonal().minCoeff(), 1e-8) << "wall " << w.id;
+    if (std::find(own.begin(), own.end(), w.id) != own.end()) ++shared_own;
+  }
+  EXPECT_EQ(distiller.graph().walls.size(), 4 + shared_own);
+  EXPECT_EQ(shared_own + f.graph.stats().planes_unobserved, own.size());
 }
 
 // What the node does: the exchange begins the marginals of the map as it is

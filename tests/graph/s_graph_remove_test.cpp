@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: MIT
 // Keyframe slots reused after sparsification: the time-ordered walk (FirstKeyframe /
 // NextKeyframe), and SGraph::RemoveKeyframe, the removal a caller asks for (what it refuses and
-// what it must never lose). That it removes as sparsification does:
-// SGraphSparsification.RemovingAKeyframeOnRequestIsSparsifyingIt (s_graph_sparsify_test.cpp).
+// what it must never lose), and planes whose observers go. That it removes as sparsification
+// does: SGraphSparsification.RemovingAKeyframeOnRequestIsSparsifyingIt (s_graph_sparsify_test.cpp).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <random>
+#include <vector>
 
 #include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "s_graph_fixtures.hpp"
 
 namespace msgraphs::core {
@@ -149,6 +152,146 @@ TEST(SGraphRemoveKeyframe, LosesNothing) {
   auto report = g.Solve(SolveKind::kFull);
   ASSERT_TRUE(report);
   EXPECT_TRUE(report->usable);
+}
+
+// A carried loop is never fused into a loop the caller keeps: that one must keep its id and its
+// measurement until judged.
+TEST(SGraphRemoveKeyframe, NeverFusesIntoAKeptLoop) {
+  for (const bool keep : {false, true}) {
+    SGraph g;
+    ASSERT_TRUE(g.Init(SmallStore()));
+    ASSERT_NO_FATAL_FAILURE(StraightLine(g, 7, 0, 7));
+    Eigen::Isometry3d one = Eigen::Isometry3d::Identity(), two = one;
+    one.translation().x() = 1;
+    two.translation().x() = 2;
+    const auto judged = g.AddRelativePose(1, 3, two, LoopInformation(), RelativePoseKind::kLoopClosure);
+    ASSERT_TRUE(judged);
+    ASSERT_TRUE(g.AddRelativePose(2, 3, one, LoopInformation(), RelativePoseKind::kLoopClosure));
+    // Keyframe 2's loop to 3 can only go through the hop to 1: as 3 -> 1, parallel to `judged`.
+    const std::array<std::uint32_t, 1> kept{*judged};
+    ASSERT_TRUE(g.RemoveKeyframe(2, keep ? std::span<const std::uint32_t>(kept)
+                                         : std::span<const std::uint32_t>()));
+    EXPECT_EQ(g.stats().sparsify_carried, 1u);
+    EXPECT_EQ(g.stats().sparsify_merged, keep ? 0u : 1u) << "kept: " << keep;
+    EXPECT_EQ(g.stats().relative_factors[static_cast<std::size_t>(RelativePoseKind::kLoopClosure)],
+              keep ? 2u : 1u);
+    if (keep) {
+      EXPECT_TRUE(g.RemoveFactor(*judged));  // still there, under its id
+    }
+  }
+}
+
+// Plane observations go with their keyframe (they are never carried). A plane whose every
+// observer went would stay in the problem unmeasured, where Ceres gives it a zero covariance:
+// a removal on request never takes a plane's last observer, and its marginal is refused.
+class SGraphPlaneObservers : public ::testing::Test {
+ protected:
+  // StraightLine's line, as far as a store of 16 lets it grow; every keyframe sees wall
+  // `seen_by_all` when added; keyframe `only` alone sees wall `seen_once`. ids[i]: keyframe i's.
+  void Build(std::uint32_t count, std::uint32_t only) {
+    ASSERT_TRUE(g.Init(SmallStore()));
+    seen_by_all = *g.AddPlane(all.n, all.d, PlaneClass::kWall);
+    seen_once = *g.AddPlane(once.n, once.d, PlaneClass::kWall);
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    step.translation().x() = 1;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.translation().x() = i;
+      const auto k = g.AddKeyframe(i, T);
+      ASSERT_TRUE(k);
+      if (i > 0) {
+        ASSERT_TRUE(
+            g.AddRelativePose(ids.back(), *k, step, OdometryInformation(), RelativePoseKind::kOdometry));
+      }
+      ids.push_back(*k);
+      Observe(*k, seen_by_all, all);
+      if (i == only) Observe(*k, seen_once, once);
+    }
+  }
+  void Observe(std::uint32_t k, std::uint32_t plane, const TruePlane& truth) {
+    ASSERT_TRUE(g.AddPlaneObservation(k, plane, Measure(truth, g.keyframe_pose(k), rng, 0.01)));
+  }
+  const TruePlane all{Eigen::Vector3d::UnitY(), 2.0}, once{-Eigen::Vector3d::UnitX(), 40.0};
+  std::mt19937 rng{7};
+  SGraph g;
+  std::uint32_t seen_by_all = 0, seen_once = 0;
+  std::vector<std::uint32_t> ids;
+};
+
+TEST_F(SGraphPlaneObservers, ARemovalOnRequestNeverTakesTheLastObserver) {
+  ASSERT_NO_FATAL_FAILURE(Build(7, 2));
+  EXPECT_EQ(g.plane(seen_once).live_observations, 1u);
+  const Status refused = g.RemoveKeyframe(2);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, Errc::kInvalidArgument);
+  ASSERT_NO_FATAL_FAILURE(Observe(1, seen_once, once));  // a second observer
+  ASSERT_TRUE(g.RemoveKeyframe(2));
+  EXPECT_EQ(g.plane(seen_once).observations, 2u);       // ever
+  EXPECT_EQ(g.plane(seen_once).live_observations, 1u);  // now: keyframe 1's
+  EXPECT_EQ(g.plane(seen_by_all).live_observations, 6u);
+  const std::array<std::uint32_t, 2> both{seen_by_all, seen_once};
+  std::array<Eigen::Matrix3d, 2> covariances{};
+  ASSERT_TRUE(g.PlaneMarginals(both, covariances));
+  for (const Eigen::Matrix3d& c : covariances) EXPECT_GT(c.diagonal().minCoeff(), 1e-8);
+  EXPECT_EQ(g.stats().planes_unobserved, 0u);
+}
+
+TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverOnlyWhenNothingElseIsLeft) {
+  // Keyframe 1 would be the first victim (hops all alike: the oldest wins the tie), but it is
+  // the only one to see `seen_once`: 40 keyframes through a store of 16 leave it in place.
+  ASSERT_NO_FATAL_FAILURE(Build(40, 1));
+  EXPECT_GT(g.stats().sparsified, 20u);
+  EXPECT_TRUE(g.keyframe_active(ids[1]));
+  EXPECT_EQ(g.keyframe_stamp(ids[1]), 1.0);
+  EXPECT_EQ(g.plane(seen_once).live_observations, 1u);
+  EXPECT_EQ(g.stats().planes_unobserved, 0u);
+
+  // Every keyframe the only one to see its wall: sparsification must still make room, and the
+  // walls it leaves unmeasured are counted, keep their estimate, and have no marginal.
+  SGraph h;
+  ASSERT_TRUE(h.Init(SmallStore()));
+  std::vector<std::uint32_t> walls;
+  std::uint32_t prev = 0;
+  const std::size_t count = 24;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() << i, 0, 0;
+    const auto k = h.AddKeyframe(i, T);
+    ASSERT_TRUE(k);
+    if (i > 0) {
+      Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+      step.translation().x() = 1;
+      ASSERT_TRUE(h.AddRelativePose(prev, *k, step, OdometryInformation(), RelativePoseKind::kOdometry));
+    }
+    prev = *k;
+    const TruePlane wall{-Eigen::Vector3d::UnitX(), i + 2.0};  // 2 m ahead of keyframe i
+    walls.push_back(*h.AddPlane(wall.n, wall.d, PlaneClass::kWall));
+    ASSERT_TRUE(h.AddPlaneObservation(*k, walls.back(), Measure(wall, T, rng, 0.01)));
+  }
+  const std::size_t removed = h.stats().sparsified;
+  EXPECT_EQ(removed, count - 16);
+  EXPECT_EQ(h.stats().planes_unobserved, removed);
+  std::size_t unobserved = 0;
+  for (std::size_t i = 0; i < walls.size(); ++i) {
+    const MapPlane p = h.plane(walls[i]);
+    if (p.live_observations > 0) continue;
+    ++unobserved;
+    EXPECT_TRUE(p.active);
+    EXPECT_NEAR(p.d, static_cast<double>(i) + 2.0, 1e-9);  // never moved: nothing measures it
+    const std::array<std::uint32_t, 1> one{walls[i]};
+    std::array<Eigen::Matrix3d, 1> covariance{};
+    const Status s = h.PlaneMarginals(one, covariance);
+    ASSERT_FALSE(s);
+    EXPECT_EQ(s.error().code, Errc::kInvalidArgument);
+    SGraphSolveJob job;
+    EXPECT_EQ(h.BeginPlaneMarginals(job, one, PlaneEvidence::kOwn).error().code,
+              Errc::kInvalidArgument);
+  }
+  EXPECT_EQ(unobserved, removed);
+  const std::array<std::uint32_t, 1> newest{walls.back()};
+  std::array<Eigen::Matrix3d, 1> covariance{};
+  ASSERT_TRUE(h.PlaneMarginals(newest, covariance));  // the observed ones still have one
+  EXPECT_GT(covariance[0].diagonal().minCoeff(), 1e-8);
 }
 
 }  // namespace

@@ -52,7 +52,7 @@ TEST(SGraphWindow, ALocalSolveMovesOnlyItsWindowAndWhatItSees) {
   for (std::size_t p = 0; p < row.graph.plane_slots(); ++p) {
     const MapPlane now = row.graph.plane(static_cast<std::uint32_t>(p));
     const bool seen_in_window =
-        row.graph.keyframe_stamp(now.last_keyframe) >= row.graph.keyframe_stamp(row.ids[row.ids.size() - 10]);
+        now.last_observed_s >= row.graph.keyframe_stamp(row.ids[row.ids.size() - 10]);
     if (seen_in_window) continue;
     EXPECT_EQ(now.d, planes_before[p].d) << p;
   }
@@ -166,7 +166,7 @@ TEST(SGraphWindow, HeldSumsKeptBetweenSolvesGiveWhatSummingThemAfreshGives) {
       m.covariance *= 25;
       ASSERT_TRUE(a.AddPlaneObservation(ids_a[20], walls[2], m));
       ASSERT_TRUE(b.AddPlaneObservation(ids_b[20], walls[2], m));
-      EXPECT_EQ(a.plane(walls[2]).last_keyframe, ids_a.back());  // still the newest observer
+      EXPECT_EQ(a.plane(walls[2]).last_observed_s, a.keyframe_stamp(ids_a.back()));  // still the newest observer
     }
     const std::uint64_t rebuilt_before = a.stats().held_sums_rebuilt;
     if (i == 120) {

@@ -75,6 +75,7 @@ void CollabPublisher::Prepare(const LocalMapper& mapper,
   stats_.own_solve_unconverged = d.own_solve_unconverged;
   stats_.walls_awaiting_estimates = d.walls_awaiting_estimates;
   stats_.rooms_awaiting_estimates = d.rooms_awaiting_estimates;
+  stats_.walls_unobserved = d.walls_unobserved;
   const DistilledGraph& g = distiller_.graph();
   out.graph.CopyFrom(g);  // capacities sized alike
 

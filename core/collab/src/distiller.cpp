@@ -135,6 +135,10 @@ void Distiller::FindEligible(const SGraph& graph) {
     const MapPlane p = graph.plane(id);
     if (!p.active || p.plane_class != PlaneClass::kWall) continue;
     if (p.observations < config_.min_wall_observations && needed_[id] == 0) continue;
+    if (p.live_observations == 0) {
+      ++stats_.walls_unobserved;
+      continue;
+    }
     Eigen::LLT<Eigen::Matrix3d> llt(p.information);
     if (llt.info() != Eigen::Success) continue;  // not yet constrained in every direction
     eligible_.push_back(id);

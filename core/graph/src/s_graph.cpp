@@ -299,11 +299,10 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
       p.info.basis_u.dot(T.translation()), p.info.basis_v.dot(T.translation()), 1;
   p.info.information += J.transpose() * information * J;
   ++p.info.observations;
+  ++p.info.live_observations;
   // The newest observer (the local solve frees a plane its window sees): an observation by an
   // older keyframe does not move it back.
-  if (!m.ValidKeyframe(p.info.last_keyframe) ||
-      m.keyframes[p.info.last_keyframe].stamp_s <= m.keyframes[keyframe].stamp_s)
-    p.info.last_keyframe = keyframe;
+  p.info.last_observed_s = std::max(p.info.last_observed_s, m.keyframes[keyframe].stamp_s);
   return Ok();
 }
 
@@ -551,6 +550,10 @@ Status SGraph::PlaneMarginals(std::span<const std::uint32_t> ids,
     if (id >= m.plane_count || !m.planes[id].in_problem)
       return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
     const PlaneNode& p = m.planes[id];
+    // Nothing measures it any more (its observers were sparsified away): Ceres would give it
+    // a zero covariance, certainty it never had.
+    if (p.info.live_observations == 0)
+      return Error{Errc::kInvalidArgument, "plane marginals: the plane has no observation left"};
     planes.push_back({p.n, p.d, p.info.basis_u, p.info.basis_v});
   }
   // Every block but the origin's is variable in the graph's problem (local solves move a

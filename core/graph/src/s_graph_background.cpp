@@ -56,6 +56,8 @@ Status SGraph::BeginPlaneMarginals(SGraphSolveJob& job,
   for (std::uint32_t id : ids) {
     if (id >= m.plane_count || !m.planes[id].in_problem)
       return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
+    if (m.planes[id].info.live_observations == 0)  // as PlaneMarginals: no zero covariance
+      return Error{Errc::kInvalidArgument, "plane marginals: the plane has no observation left"};
   }
   if (auto s = CopyIntoJob(job, evidence); !s) return s;
   j.kind = JobKind::kMarginals;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "msgraphs/core/geometry/se3.hpp"
@@ -47,6 +48,7 @@ struct KeyframeNode {
   Eigen::Isometry3d measurement_from_prev = Eigen::Isometry3d::Identity();
   Matrix6d information_from_prev = Matrix6d::Zero();
   bool active = false;
+  bool last_observer = false;  // Sparsify's scratch: the only observer left of some plane
 };
 
 struct PlaneNode {
@@ -313,7 +315,12 @@ struct SGraph::Impl {
         break;
       case FactorKind::kPlane:
         --stats.plane_factors;
-        if (f.b < planes.size()) planes[f.b].held_epoch = 0;  // its held sum may include it
+        if (f.b < planes.size()) {
+          planes[f.b].held_epoch = 0;  // its held sum may include it
+          if (planes[f.b].info.live_observations > 0 &&
+              --planes[f.b].info.live_observations == 0)
+            ++stats.planes_unobserved;
+        }
         break;
       case FactorKind::kRoom:
         --stats.room_factors;
@@ -470,10 +477,13 @@ struct SGraph::Impl {
   // Removes keyframe v (active, between two keyframes): its loops carried to a neighbour, its
   // neighbours joined by the composed hop, its plane observations dropped, its slot freed. The
   // body of Sparsify once the victim is chosen; counts what it carries and drops, not itself.
-  void RemoveKeyframe(std::uint32_t v);
-  // Whether removing v would carry every loop on it and join its neighbours (no constraint
-  // dropped): what a removal on request requires.
+  // Factors in `keep_factors` stay as they are (a carried loop is never fused into one).
+  void RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t> keep_factors = {});
+  // Whether removing v would carry every loop on it and join its neighbours, and leave every
+  // plane it sees observed (no constraint dropped): what a removal on request requires.
   bool RemovalLosesNothing(std::uint32_t v) const;
+  // Whether v holds the last observation of some plane.
+  bool LastObserverOfAPlane(std::uint32_t v) const;
   // The oldest keyframe of the local window (kNone when fewer keyframes than the window).
   std::int32_t WindowStart() const;
   // A relative factor's measurement T_a_b and information, as its residual holds them.
@@ -481,12 +491,13 @@ struct SGraph::Impl {
                            Eigen::Isometry3d& T_a_b,
                            Matrix6d& information) const;
   // Adds T_from_to between two keyframes, fused into a parallel factor of the same kind (not a
-  // chain hop) when there is one. False when the graph refused it.
+  // chain hop, not one of `keep_factors`) when there is one. False when the graph refused it.
   bool AddOrFuseRelative(std::uint32_t from,
                          std::uint32_t to,
                          const Eigen::Isometry3d& T_from_to,
                          const Matrix6d& information,
                          RelativePoseKind kind,
+                         std::span<const std::uint32_t> keep_factors,
                          bool& fused);
 
   // Every parameter value in one flat buffer (sized at Init), to undo a solve.

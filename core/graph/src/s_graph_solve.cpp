@@ -61,14 +61,13 @@ std::size_t SGraph::Impl::CollectWindow() {
   window_oldest_free_s = window_oldest_free != kNone
                              ? keyframes[static_cast<std::size_t>(window_oldest_free)].stamp_s
                              : std::numeric_limits<double>::infinity();
-  // A plane moves when its newest observer does: keyframe slots are reused, so compare stamps.
+  // A plane moves when its newest observer does. By stamp: keyframe slots are reused, and a
+  // removed observer was outside the window (so older than it).
   const double window_stamp = keyframes[static_cast<std::size_t>(window_start)].stamp_s;
   for (std::size_t i = 0; i < plane_count; ++i) {
     PlaneNode& p = planes[i];
     if (!p.in_problem) continue;
-    const std::uint32_t last = p.info.last_keyframe;
-    const bool free = last < keyframe_high_water && keyframes[last].active &&
-                      keyframes[last].stamp_s >= window_stamp;
+    const bool free = p.info.last_observed_s >= window_stamp;
     p.window_free = free;
     if (!free) continue;
     window_free_planes.emplace_back(p.n, static_cast<std::uint32_t>(i));

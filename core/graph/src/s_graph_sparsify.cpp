@@ -8,6 +8,7 @@
 // (covariance intersection with equal weights): the factors are then never jointly more certain
 // than the one measurement they share, whatever its correlation with itself.
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -85,14 +86,20 @@ bool SGraph::Impl::AddOrFuseRelative(std::uint32_t from,
                                      const Eigen::Isometry3d& T_from_to,
                                      const Matrix6d& information,
                                      RelativePoseKind kind,
+                                     std::span<const std::uint32_t> keep_factors,
                                      bool& fused) {
   fused = false;
   // A parallel factor of the same kind: one factor with both measurements, so that loops
   // carried again and again over an endless patrol do not pile up between the same keyframes.
+  // Never one the caller keeps (a loop still to be judged by its id).
   for (std::size_t i = 0; i < factor_high_water; ++i) {
     const FactorRecord& f = factors[i];
     if (!f.active || f.kind != FactorKind::kRelative || f.chain || f.relative != kind ||
         !((f.a == from && f.b == to) || (f.a == to && f.b == from))) {
+      continue;
+    }
+    if (std::find(keep_factors.begin(), keep_factors.end(), static_cast<std::uint32_t>(i)) !=
+        keep_factors.end()) {
       continue;
     }
     Eigen::Isometry3d T;
@@ -132,19 +139,44 @@ bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) const {
       continue;
     if (Route(f.a == v ? f.b : f.a, p, n, a, b) == Via::kNowhere) return false;
   }
-  return true;
+  return !LastObserverOfAPlane(v);
+}
+
+bool SGraph::Impl::LastObserverOfAPlane(std::uint32_t v) const {
+  // Plane observations are dropped with their keyframe, never carried: a plane whose every
+  // live observation is v's would be left unmeasured (held where it is, with no marginal).
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!f.active || f.kind != FactorKind::kPlane || f.a != v) continue;
+    std::uint32_t by_v = 0;
+    for (std::size_t j = 0; j < factor_high_water; ++j) {
+      const FactorRecord& g = factors[j];
+      if (g.active && g.kind == FactorKind::kPlane && g.a == v && g.b == f.b) ++by_v;
+    }
+    if (planes[f.b].info.live_observations <= by_v) return true;
+  }
+  return false;
 }
 
 bool SGraph::Impl::Sparsify() {
   if (origin == kNone || newest == kNone) return false;
   const std::int32_t window_start = WindowStart();
   if (window_start == kNone) return false;
+  // Which keyframes hold some plane's only live observation: removing one leaves that plane
+  // unmeasured, so they go last. (One pass over the factors, not one per candidate.)
+  for (std::size_t k = 0; k < keyframe_high_water; ++k) keyframes[k].last_observer = false;
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (f.active && f.kind == FactorKind::kPlane && planes[f.b].info.live_observations == 1)
+      keyframes[f.a].last_observer = true;
+  }
   // The victim, cheapest loss first: no loop closure on it; then loops that can be carried
-  // (a hop with a measurement to carry them through), fewest first; then the rest. Within
-  // that, the shortest hop between its neighbours (the most redundant keyframe). Never the
-  // origin, never in the local window.
+  // (a hop with a measurement to carry them through), fewest first; then the rest. Every
+  // keyframe that is some plane's last observer after all those. Within that, the shortest hop
+  // between its neighbours (the most redundant keyframe). Never the origin, never in the local
+  // window.
   std::int32_t victim = kNone;
-  int best_tier = 3;
+  int best_tier = 6;
   std::uint32_t best_loops = 0;
   double best_hop = 0;
   for (std::int32_t k = keyframes[static_cast<std::size_t>(origin)].next;
@@ -154,7 +186,8 @@ bool SGraph::Impl::Sparsify() {
     const bool carriable =
         !node.information_from_prev.isZero(0.0) ||
         !keyframes[static_cast<std::size_t>(node.next)].information_from_prev.isZero(0.0);
-    const int tier = node.loop_factors == 0 ? 0 : (carriable ? 1 : 2);
+    const int tier =
+        (node.last_observer ? 3 : 0) + (node.loop_factors == 0 ? 0 : (carriable ? 1 : 2));
     const double hop = (Pose(static_cast<std::uint32_t>(node.prev)).translation() -
                         Pose(static_cast<std::uint32_t>(node.next)).translation())
                            .norm();
@@ -175,7 +208,7 @@ bool SGraph::Impl::Sparsify() {
   return true;
 }
 
-void SGraph::Impl::RemoveKeyframe(std::uint32_t v) {
+void SGraph::Impl::RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t> keep_factors) {
   MSGRAPHS_ASSERT(ValidKeyframe(v) && keyframes[v].prev != kNone && keyframes[v].next != kNone,
                   "only a keyframe between two others is removed");
   const auto p = static_cast<std::uint32_t>(keyframes[v].prev);
@@ -237,7 +270,7 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v) {
     Matrix6d information_kt;
     bool fused = false;
     if (Invert(sigma_kt, information_kt) &&
-        AddOrFuseRelative(k, t, Z_kt, information_kt, kind, fused)) {
+        AddOrFuseRelative(k, t, Z_kt, information_kt, kind, keep_factors, fused)) {
       ++stats.sparsify_carried;
       if (fused) ++stats.sparsify_merged;
     } else {
@@ -304,7 +337,7 @@ Status SGraph::RemoveKeyframe(std::uint32_t id, std::span<const std::uint32_t> k
   if (!m.RemovalLosesNothing(id))
     return Error{Errc::kInvalidArgument, "removing the keyframe would lose a constraint"};
   ++m.stats.revision;  // every call that may change the graph
-  m.RemoveKeyframe(id);
+  m.RemoveKeyframe(id, keep_factors);
   ++m.stats.removed_keyframes;
   return Ok();
 }

@@ -218,10 +218,12 @@ void Node::Impl::PrintReport() {
           " by the marginals thread; walls held back to the next exchange (shareable only after "
           "the copy) %" PRIu64 " times; own evidence (solved without peers' priors) %" PRIu64
           " times, %" PRIu64 " not converged, %" PRIu64 " failed; walls / rooms held back for their own "
-          "estimates %" PRIu64 " / %" PRIu64 " times\n",
+          "estimates %" PRIu64 " / %" PRIu64 " times; walls no longer observed (sparsified away) held "
+          "back %" PRIu64 " times\n",
           ps.marginal_updates, ps.marginal_failures, marginals_solver.runs(),
           ps.walls_awaiting_marginals, ps.own_evidence_jobs, ps.own_solve_unconverged,
-          ps.own_solve_failures, ps.walls_awaiting_estimates, ps.rooms_awaiting_estimates);
+          ps.own_solve_failures, ps.walls_awaiting_estimates, ps.rooms_awaiting_estimates,
+          ps.walls_unobserved);
   const core::KeyframeCloudStore& store = mapper.clouds();
   const core::KeyframeCloudStoreStats& store_stats = store.stats();
   Appendf(text,

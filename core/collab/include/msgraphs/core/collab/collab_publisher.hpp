@@ -80,6 +80,7 @@ struct CollabPublisherStats {
   /// solves that failed, rooms held back for want of an own estimate (summed).
   std::uint64_t own_evidence_jobs = 0, own_solve_unconverged = 0, own_solve_failures = 0;
   std::uint64_t walls_awaiting_estimates = 0, rooms_awaiting_estimates = 0;
+  std::uint64_t walls_unobserved = 0;  ///< not shared: nothing measures them any more (summed)
   std::uint64_t free_space_build_failures = 0;
   std::uint64_t rooms_refused = 0, room_clouds_too_large = 0, rooms_deferred = 0;
   std::size_t room_points_peak = 0;

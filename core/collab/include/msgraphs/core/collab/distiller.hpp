@@ -118,6 +118,10 @@ class Distiller {
     /// because the job that gives the own estimates did not hold them.
     std::uint64_t own_evidence_jobs = 0, own_solve_unconverged = 0, own_solve_failures = 0;
     std::uint64_t walls_awaiting_estimates = 0, rooms_awaiting_estimates = 0;
+    /// Walls not shared, summed over Updates, because nothing measures them any more (their
+    /// observers were sparsified away: MapPlane::live_observations). Their marginal is
+    /// undefined; one shared before keeps what it was sent with.
+    std::uint64_t walls_unobserved = 0;
   };
   const Stats& stats() const { return stats_; }
 

@@ -30,6 +30,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <limits>
 #include <span>
 
 #include "msgraphs/base/expected.hpp"
@@ -112,8 +113,13 @@ struct MapPlane {
   Eigen::Vector3d basis_u = Eigen::Vector3d::UnitY();
   Eigen::Vector3d basis_v = Eigen::Vector3d::UnitZ();
   PlaneClass plane_class = PlaneClass::kWall;
-  std::uint32_t observations = 0;
-  std::uint32_t last_keyframe = 0;  ///< newest keyframe that observed it
+  std::uint32_t observations = 0;  ///< observations ever added (how established it is)
+  /// Observations in the graph now: sparsification and RemoveKeyframe drop a removed keyframe's.
+  /// Zero means nothing measures the plane any more (its estimate stays, its marginal is
+  /// undefined: PlaneMarginals refuses it).
+  std::uint32_t live_observations = 0;
+  /// Stamp of the newest keyframe that observed it (a stamp, not a slot: slots are reused).
+  double last_observed_s = -std::numeric_limits<double>::infinity();
   bool active = false;
 };
 
@@ -155,6 +161,11 @@ struct SGraphStats {
   std::uint64_t rejected_keyframes = 0, sparsify_failed = 0;
   /// Keyframes removed on request (RemoveKeyframe), not counted in `sparsified`.
   std::uint64_t removed_keyframes = 0;
+  /// Planes whose last live observation went: with its keyframe, by sparsification at a full
+  /// store (which takes a plane's last observer only when every candidate is one; a removal on
+  /// request never does), or by RemoveFactor. Such a plane keeps its estimate; PlaneMarginals
+  /// refuses it (MapPlane::live_observations).
+  std::uint64_t planes_unobserved = 0;
   std::size_t planes = 0, rooms = 0, floors = 0;
   std::size_t factors = 0, factors_peak = 0;
   std::array<std::size_t, 4> relative_factors{};  ///< by RelativePoseKind
@@ -225,11 +236,12 @@ class SGraph {
   /// caller that knows the keyframe is redundant (a revisit of a place another keyframe keeps).
   /// A carried loop is another factor (it may take another id, or be fused into a parallel
   /// one), so a caller that holds loop factor ids (loops still to be judged) passes them as
-  /// `keep_factors`, and a keyframe one of them ends at is kept. kNotFound for an inactive id; kInvalidArgument for the origin, a keyframe in the
-  /// local window, one a kept factor ends at, or one whose removal would lose a constraint (a
-  /// loop with no hop to carry it, a hop without a measurement): unlike sparsification at a
-  /// full store, a removal on request never drops anything. A background job begun before
-  /// keeps what it borrowed (ApplyFullSolve skips the keyframe).
+  /// `keep_factors`: a keyframe one of them ends at is kept, and no loop is fused into one.
+  /// kNotFound for an inactive id; kInvalidArgument for the origin, a keyframe in the local
+  /// window, one a kept factor ends at, or one whose removal would lose a constraint (a loop
+  /// with no hop to carry it, a hop without a measurement, a plane's last live observation):
+  /// unlike sparsification at a full store, a removal on request never drops anything. A
+  /// background job begun before keeps what it borrowed (ApplyFullSolve skips the keyframe).
   Status RemoveKeyframe(std::uint32_t id, std::span<const std::uint32_t> keep_factors = {});
 
   /// A new plane landmark in the map frame (normal normalised here).
@@ -284,7 +296,8 @@ class SGraph {
   /// (what PlaneMarginals would give now), computed by the job's Run at the copied estimates
   /// without solving: the distiller's marginals off the graph's thread. The graph lends its
   /// costs until Run returns; read the job after Complete, then Release it. kWouldBlock when the
-  /// job is pending; kNotFound for a plane not in the optimisation; kCapacityExceeded beyond the
+  /// job is pending; kNotFound for a plane not in the optimisation; kInvalidArgument for one with
+  /// no live observation (as PlaneMarginals); kCapacityExceeded beyond the
   /// job's plane capacity. No allocation.
   ///
   /// PlaneEvidence::kOwn leaves the plane priors (AddPlanePrior: what other robots said) out of
@@ -320,7 +333,8 @@ class SGraph {
   MapPlane plane(std::uint32_t id) const;
   /// Marginal covariances of planes `ids` from the whole optimisation (the uncertainty of the
   /// keyframes that saw them included), over (alpha, beta, delta_d) along each plane's basis_u /
-  /// basis_v. kDegenerate when the problem is rank deficient. Allocates (Ceres): call it at the
+  /// basis_v. kDegenerate when the problem is rank deficient; kInvalidArgument for a plane with
+  /// no live observation (its marginal is undefined). Allocates (Ceres): call it at the
   /// distillation cadence, not on the per-keyframe path.
   Status PlaneMarginals(std::span<const std::uint32_t> ids,
                         std::span<Eigen::Matrix3d> covariances) const;
