@@ -29,7 +29,7 @@ TEST(CollabOptions, ThresholdsDelaysAndSummaryAreOptions) {
   std::string error;
   ASSERT_TRUE(Parse({"--run", "/r", "--wrong-origin-m", "0.25", "--wrong-origin-deg", "1.5",
                      "--delay-s", "2=90", "--summary", "/s.json", "--mode", "keyframes",
-                     "--until-s", "20.05"},
+                     "--until-s", "20.05", "--max-keyframes", "1000", "--timing"},
                     o, error))
       << error;
   EXPECT_EQ(o.evaluation.wrong_origin_m, 0.25);
@@ -38,12 +38,16 @@ TEST(CollabOptions, ThresholdsDelaysAndSummaryAreOptions) {
   EXPECT_EQ(o.summary_path, "/s.json");
   EXPECT_TRUE(o.keyframes);
   EXPECT_EQ(o.until_s, 20.05);
+  EXPECT_EQ(o.max_keyframes, 1000u);
+  EXPECT_TRUE(o.timing);
   // The defaults: 0.5 m and 2 deg, and the whole mission.
   Options d;
   ASSERT_TRUE(Parse({"--run", "/r"}, d, error));
   EXPECT_EQ(d.evaluation.wrong_origin_m, 0.5);
   EXPECT_EQ(d.evaluation.wrong_origin_deg, 2.0);
   EXPECT_EQ(d.until_s, 0.0);
+  EXPECT_EQ(d.max_keyframes, 0u);  // the mapper's own
+  EXPECT_FALSE(d.timing);
 }
 
 TEST(CollabOptions, BadValuesAreRefusedWithAReason) {
@@ -54,6 +58,10 @@ TEST(CollabOptions, BadValuesAreRefusedWithAReason) {
         {"--run", "/r", "--exchange-every-s", "0"},
         {"--run", "/r", "--until-s", "0"},
         {"--run", "/r", "--until-s", "nan"},
+        {"--run", "/r", "--max-keyframes", "0"},
+        {"--run", "/r", "--max-keyframes", "12.5"},
+        {"--run", "/r", "--max-keyframes", "-3"},
+        {"--run", "/r", "--max-keyframes"},
         {"--run", "/r", "--mode", "magic"},
         {"--run", "/r", "--summary"},
         {"--wrong-origin-m", "0.5"}}) {

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "msgraphs/tools/ate.hpp"
 #include "msgraphs/tools/truth_pairing.hpp"
@@ -136,6 +137,49 @@ TEST(CollabSim, TheRoomsModeFeedsMatchedWallsBackAndFeedbackOffFeedsNone) {
   ASSERT_NE(PriorsOfRobot(off, 1), kAbsent) << off;
   EXPECT_EQ(PriorsOfRobot(off, 1), 0u) << off;
   EXPECT_EQ(PriorsOfRobot(off, 2), 0u) << off;
+  std::filesystem::remove_all(run);
+  std::filesystem::remove(log);
+}
+
+// The fleet evaluation's knobs (issue 19): each robot's graph bounded by --max-keyframes (a
+// value the graph refuses is an error, not a silent default), and --timing's per-robot tables.
+TEST(CollabSim, ABoundedGraphAndItsTimingAreReported) {
+  const std::string run = Temp("bounded_run"), log = Temp("bounded_log");
+  std::filesystem::remove_all(run);
+  ASSERT_EQ(
+      Wait(Spawn({MSGRAPHS_SIM_TOOL, "--world", MSGRAPHS_OFFICE_WORLD, "--out", run, "--robots",
+                  "2", "--duration-s", "40", "--seed", "2", "--shared-rooms", "0"})),
+      0);
+  auto collab = [&](const std::string& options) {
+    const int status = Wait(Spawn({"/bin/sh", "-c",
+                                   std::string(MSGRAPHS_COLLAB_TOOL) + " --run " + run + " " +
+                                       options + " > " + log + " 2>&1"}));
+    std::ifstream in(log);
+    std::stringstream text;
+    text << in.rdbuf();
+    return std::pair{status, text.str()};
+  };
+  const auto [status, text] = collab("--max-keyframes 32 --timing");
+  ASSERT_EQ(status, 0) << text;
+  for (const char* robot : {"robot 1 timing: ", "robot 2 timing: "}) {
+    const std::size_t at = text.find(robot);
+    ASSERT_NE(at, std::string::npos) << text;
+    std::size_t mapped = 0, in_graph = 0, peak = 0, sparsified = 0;
+    ASSERT_EQ(std::sscanf(text.c_str() + at + std::string(robot).size(),
+                          "%zu keyframes mapped, %zu in the graph (peak %zu, %zu sparsified)",
+                          &mapped, &in_graph, &peak, &sparsified),
+              4)
+        << text.substr(at, 120);
+    EXPECT_GT(mapped, 32u) << robot;  // more than the store holds: it was sparsified to it
+    EXPECT_EQ(in_graph, 32u) << robot;
+    EXPECT_EQ(peak, 32u) << robot;
+    EXPECT_EQ(sparsified, mapped - 32) << robot;
+  }
+  EXPECT_NE(text.find("per keyframe total by map size [ms]"), std::string::npos);
+  EXPECT_NE(text.find("resident set at the end: "), std::string::npos);
+  const auto [refused, why] = collab("--max-keyframes 20");  // not above the local window (20)
+  EXPECT_EQ(refused, 1) << why;
+  EXPECT_NE(why.find("collab: "), std::string::npos) << why;
   std::filesystem::remove_all(run);
   std::filesystem::remove(log);
 }

@@ -43,7 +43,10 @@ MissionRun RunLockStep(Mission& mission,
     run.mission_time_s = t;
     ProcessNextScan(*next);
   }
-  for (auto& r : mission.robots) static_cast<void>(r->mapper.Finish());
+  for (auto& r : mission.robots) {
+    if (r->solver.joinable()) r->solver.join();  // its last background solve, done
+    static_cast<void>(r->mapper.Finish());
+  }
   mission.Exchange(run.mission_time_s);
   run.exchanges.push_back(Record(mission, run.mission_time_s));
   after_exchange(run.mission_time_s);

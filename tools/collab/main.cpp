@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     const fs::path dir = fs::path(o.run) / ("robot" + std::to_string(i + 1));
     if (!fs::exists(dir / "velodyne.pcap")) break;
     const StartDelay delay = ResolveStartDelay(i + 1, mission_delays_s, o.delays_s);
-    auto robot = OpenRobot(dir.string(), i, delay.delay_s, o.session, error);
+    auto robot = OpenRobot(dir.string(), i, delay.delay_s, o.max_keyframes, o.session, error);
     if (!robot) {
       std::fprintf(stderr, "collab: %s\n", error.c_str());
       return 1;
@@ -111,5 +111,15 @@ int main(int argc, char** argv) {
   }
   const std::string text = o.markdown ? MarkdownRow(report) : TextReport(report);
   std::fputs(text.c_str(), stdout);
+  if (o.timing) {
+    for (const auto& r : mission.robots) {
+      const msgraphs::core::SGraphStats g = r->mapper.graph().stats();
+      std::printf("robot %d timing: %zu keyframes mapped, %zu in the graph (peak %zu, %zu sparsified)\n",
+                  r->id(), r->timing.total().size(), g.keyframes, g.keyframes_peak, g.sparsified);
+      r->timing.Print(stdout);
+    }
+    std::printf("resident set at the end: %.1f MB (the whole fleet, one process)\n",
+                msgraphs::tools::KeyframeTiming::ResidentMb());
+  }
   return 0;
 }

@@ -28,9 +28,14 @@ bool ParseOptions(int argc, char** argv, Options& o, std::string& error) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
-    if (v == nullptr && a != "--markdown") return fail(a + ": unknown option or missing value");
+    const bool flag = a == "--markdown" || a == "--timing";
+    if (v == nullptr && !flag) return fail(a + ": unknown option or missing value");
     if (a == "--markdown") {
       o.markdown = true;
+      continue;
+    }
+    if (a == "--timing") {
+      o.timing = true;
       continue;
     }
     ++i;  // every other option takes a value
@@ -49,6 +54,11 @@ bool ParseOptions(int argc, char** argv, Options& o, std::string& error) {
       // The mission as it stood at S: the report and --explain judge the maps and decisions of
       // that moment (a merge at 20 s undone at 30 s is seen as it was decided).
       if (!Number(v, o.until_s) || !(o.until_s > 0)) return fail(a + " takes seconds > 0");
+    } else if (a == "--max-keyframes") {
+      // A whole number of keyframes; the graph's own validation judges the value (OpenRobot).
+      if (!Number(v, number) || !(number >= 1) || number > 1e7 || number != std::floor(number))
+        return fail(a + " takes a whole number of keyframes >= 1");
+      o.max_keyframes = static_cast<std::size_t>(number);
     } else if (a == "--delay-s") {
       // ROBOT=SECONDS: that robot starts later in mission time (a late joiner when longer than
       // the others' missions: it arrives with its whole map).

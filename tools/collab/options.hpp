@@ -4,6 +4,7 @@
 // missing file or key means no delay).
 #pragma once
 
+#include <cstddef>
 #include <map>
 #include <string>
 
@@ -22,6 +23,12 @@ struct Options {
   bool markdown = false;
   double every_s = 10.0;
   double until_s = 0;  ///< --until-s: the mission ends at this mission time (0: at its end)
+  /// --max-keyframes: each robot's S-Graph keyframe store (0: the mapper's default). Smaller
+  /// than a mission's keyframes, the graph is sparsified to it (docs/s-graph.md).
+  std::size_t max_keyframes = 0;
+  /// --timing: each robot's per-stage keyframe timing and its growth with the map, and the
+  /// process's resident set, after the report (issue 19's fleet evaluation).
+  bool timing = false;
   std::map<int, double> delays_s;  ///< --delay-s: robot id -> start delay
   core::CollabSessionConfig session;
   EvaluationConfig evaluation;
@@ -35,7 +42,7 @@ inline constexpr const char* kUsage =
     "                       [--exchange-every-s 10] [--delay-s ROBOT=SECONDS]...\n"
     "                       [--wrong-origin-m 0.5]\n"
     "                       [--wrong-origin-deg 2] [--out DIR] [--summary FILE] [--explain DIR]\n"
-    "                       [--until-s S] [--markdown]\n";
+    "                       [--until-s S] [--max-keyframes N] [--timing] [--markdown]\n";
 
 /// False with `error` on a bad command line (the caller prints it and the usage, exit 2).
 bool ParseOptions(int argc, char** argv, Options& o, std::string& error);

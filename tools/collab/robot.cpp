@@ -2,6 +2,7 @@
 #include "robot.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <limits>
 #include <span>
@@ -44,6 +45,7 @@ void FeedOdometry(Robot& r, double until) {
 std::unique_ptr<Robot> OpenRobot(const std::string& dir_name,
                                  int index,
                                  double delay_s,
+                                 std::size_t max_keyframes,
                                  core::CollabSessionConfig session_config,
                                  std::string& error) {
   const fs::path dir(dir_name);
@@ -58,6 +60,7 @@ std::unique_ptr<Robot> OpenRobot(const std::string& dir_name,
   }
   r->candump.emplace(std::move(*candump));
   core::LocalMapperConfig config;
+  if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;  // validated by Init
   session_config.robot = r->id();
   Status s = r->mapper.Init(config);
   if (s) s = r->session.Init(session_config, config.graph, -config.base_height_m);
@@ -92,7 +95,22 @@ void ProcessNextScan(Robot& r) {
   core::LidarScanView view{points, times, r.pending->start_time.seconds_since_epoch(),
                            r.pending->end_time.seconds_since_epoch()};
   FeedOdometry(r, view.end_s + 0.05);
-  static_cast<void>(r.mapper.AddScan(view));
+  const auto sweep_start = std::chrono::steady_clock::now();
+  const auto outcome = r.mapper.AddScan(view, &r.timing);
+  if (outcome && *outcome == core::ScanOutcome::kNotKeyframe) {
+    r.timing.Sweep(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                             sweep_start)
+                       .count());
+  }
+  if (r.mapper.stats().full_solves_begun != r.solves_begun) {
+    r.solves_begun = r.mapper.stats().full_solves_begun;
+    if (core::SGraphSolveJob* job = r.mapper.background_solve()) {
+      if (r.solver.joinable()) r.solver.join();  // the previous job was applied before this began
+      r.solver = std::jthread([job] {
+        if (job->TryClaim()) job->Run();
+      });
+    }
+  }
   Advance(r);
 }
 

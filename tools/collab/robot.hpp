@@ -12,6 +12,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "msgraphs/drivers/can_odometry/candump_file.hpp"
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/velodyne/recorded_scans.hpp"
+#include "msgraphs/tools/keyframe_timing.hpp"
 #include "msgraphs/tools/tum.hpp"
 
 namespace msgraphs::tools::collab {
@@ -63,13 +65,22 @@ struct Robot {
   std::vector<core::MergeLogEntry> merge_log;
   KeyframeBaselineState baseline;
   std::vector<StampedPose> truth;  ///< ground_truth.tum as read (empty when absent)
+  /// Its mapper's per-stage keyframe timing (--timing prints it).
+  KeyframeTiming timing;
+  /// The full solve its mapper began, run on a thread of its own as the node's solver thread
+  /// does (the map does not depend on it: the mapper applies it at a fixed keyframe, running it
+  /// there if it is not done). Declared last: joined before the mapper goes.
+  std::uint64_t solves_begun = 0;
+  std::jthread solver;
 };
 
 /// Opens robot `index`'s recording in `dir` (velodyne.pcap, odometry.log, ground_truth.tum) and
 /// initialises its mapper, session and baseline graph. nullptr with `error` set on failure.
+/// `max_keyframes`: the S-Graph's keyframe store (0: the mapper's default).
 std::unique_ptr<Robot> OpenRobot(const std::string& dir,
                                  int index,
                                  double delay_s,
+                                 std::size_t max_keyframes,
                                  core::CollabSessionConfig session_config,
                                  std::string& error);
 

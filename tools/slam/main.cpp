@@ -40,6 +40,7 @@
 #include "msgraphs/drivers/velodyne/recorded_scans.hpp"
 #include "msgraphs/tools/ate.hpp"
 #include "msgraphs/tools/candump_odometry.hpp"
+#include "msgraphs/tools/keyframe_timing.hpp"
 #include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
@@ -50,102 +51,6 @@ namespace {
 using namespace msgraphs;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-// Per-stage wall time of every keyframe.
-class Timer final : public core::StageObserver {
- public:
-  /// The growth table's runs: 300 keyframes, the map size the bound is stated against.
-  static constexpr std::size_t kGrowthKeyframes = 300;
-  void KeyframeStarted() override {
-    start_ = last_ = Clock::now();
-    active_ = true;
-    pending_.fill(-1);
-  }
-  void StageEnded(core::MapperStage stage) override {
-    const auto now = Clock::now();
-    pending_[static_cast<std::size_t>(stage)] =
-        std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    if (stage == core::MapperStage::kRooms && active_) {
-      // A keyframe's stages are kept only once it is mapped (a refused keyframe ends early), so
-      // every stage's n-th entry is the n-th keyframe's.
-      for (std::size_t s = 0; s < stages_.size(); ++s)
-        stages_[s].push_back(std::max(0.0, pending_[s]));  // a stage not run took 0
-      total_.push_back(std::chrono::duration<double, std::milli>(now - start_).count());
-      active_ = false;
-      // The resident set at the end of each run, to see whether memory is flat (issue 19).
-      last_rss_mb_ = ResidentMb();
-      if (total_.size() % kGrowthKeyframes == 0) rss_mb_.push_back(last_rss_mb_);
-    }
-  }
-  /// The process's resident set now (Linux /proc; 0 where it cannot be read).
-  static double ResidentMb() {
-    std::FILE* f = std::fopen("/proc/self/statm", "r");
-    if (f == nullptr) return 0;
-    unsigned long long size_pages = 0, resident_pages = 0;
-    const int read = std::fscanf(f, "%llu %llu", &size_pages, &resident_pages);
-    std::fclose(f);
-    if (read != 2) return 0;
-    return static_cast<double>(resident_pages) * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1e6;
-  }
-  static double Percentile(std::vector<double> v, double p) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    return v[static_cast<std::size_t>(
-        std::min<double>(static_cast<double>(v.size() - 1), p * static_cast<double>(v.size())))];
-  }
-  void Print() const {
-    std::printf("per keyframe [ms]        p50     p90     p99     max\n");
-    for (std::size_t s = 0; s < stages_.size(); ++s) {
-      const auto& v = stages_[s];
-      std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n",
-                  core::ToString(static_cast<core::MapperStage>(s)), Percentile(v, 0.5),
-                  Percentile(v, 0.9), Percentile(v, 0.99), Percentile(v, 1.0));
-    }
-    std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "total", Percentile(total_, 0.5),
-                Percentile(total_, 0.9), Percentile(total_, 0.99), Percentile(total_, 1.0));
-    // How the cost grows with the map (issue 19's bound: p99 at 4,000 keyframes against 300):
-    // the total of each run of kGrowthKeyframes keyframes in turn.
-    std::printf("per keyframe total by map size [ms]   p50     p99     max  RSS at end [MB]\n");
-    for (std::size_t first = 0, run = 0; first < total_.size(); first += kGrowthKeyframes, ++run) {
-      const std::size_t last = std::min(total_.size(), first + kGrowthKeyframes);
-      const std::vector<double> v = Run(total_, first, last);
-      std::printf("  keyframes %5zu-%-5zu         %7.2f %7.2f %7.2f  %7.1f\n", first, last - 1,
-                  Percentile(v, 0.5), Percentile(v, 0.99), Percentile(v, 1.0),
-                  run < rss_mb_.size() ? rss_mb_[run] : last_rss_mb_);
-    }
-    // Which stages grow: each stage's p50 and p99 per run (one value per keyframe and stage).
-    std::printf("per stage by map size [ms], p50/p99 per run of %zu keyframes\n", kGrowthKeyframes);
-    for (std::size_t s = 0; s < stages_.size(); ++s) {
-      const auto& v = stages_[s];
-      std::printf("  %-18s", core::ToString(static_cast<core::MapperStage>(s)));
-      for (std::size_t first = 0; first < v.size(); first += kGrowthKeyframes) {
-        const std::vector<double> r = Run(v, first, std::min(v.size(), first + kGrowthKeyframes));
-        std::printf(" %.1f/%.1f", Percentile(r, 0.5), Percentile(r, 0.99));
-      }
-      std::printf("\n");
-    }
-    std::printf("per sweep between keyframes [ms] (scan tracking), %zu sweeps\n", sweeps_.size());
-    std::printf("  %-18s %7.2f %7.2f %7.2f %7.2f\n", "sweep", Percentile(sweeps_, 0.5),
-                Percentile(sweeps_, 0.9), Percentile(sweeps_, 0.99), Percentile(sweeps_, 1.0));
-  }
-  static std::vector<double> Run(const std::vector<double>& v, std::size_t first,
-                                 std::size_t last) {
-    return {v.begin() + static_cast<std::ptrdiff_t>(first),
-            v.begin() + static_cast<std::ptrdiff_t>(last)};
-  }
-  /// A sweep that was not a keyframe took this long in AddScan.
-  void Sweep(double ms) { sweeps_.push_back(ms); }
-  const std::vector<double>& total() const { return total_; }
-
- private:
-  std::array<std::vector<double>, static_cast<std::size_t>(core::MapperStage::kCount)> stages_;
-  std::vector<double> total_, sweeps_, rss_mb_;
-  std::array<double, static_cast<std::size_t>(core::MapperStage::kCount)> pending_{};
-  double last_rss_mb_ = 0;
-  Clock::time_point start_, last_;
-  bool active_ = false;
-};
 
 // "0.021" or "n/a": a failed ATE is never printed as a number.
 std::string AteCell(const tools::AteResult& ate) {
@@ -283,7 +188,7 @@ int main(int argc, char** argv) {
   }
   std::vector<Eigen::Vector3f> points;
   std::vector<float> times;
-  Timer timer;
+  tools::KeyframeTiming timer;
   const auto t_start = Clock::now();
   std::size_t scan_count = 0;
   double first_end_s = 0;
@@ -462,7 +367,7 @@ int main(int argc, char** argv) {
         world ? world->name.c_str() : run.c_str(), robot, slam.size(),
         AteCell(ate_odometry).c_str(), AteCell(ate_slam).c_str(), walls_true, walls_mapped,
         rooms_correct, rooms_mapped, rooms_visited,
-        static_cast<unsigned long long>(ms.loop_closures), Timer::Percentile(timer.total(), 0.5),
+        static_cast<unsigned long long>(ms.loop_closures), tools::KeyframeTiming::Percentile(timer.total(), 0.5),
         static_cast<double>(usage.ru_maxrss) / 1024.0);
     return 0;
   }
@@ -558,6 +463,6 @@ int main(int argc, char** argv) {
       mapper.clouds().capacity_points(), ms.local_map_points_peak,
       static_cast<double>(after_init.ru_maxrss) / 1024.0,
       static_cast<double>(usage.ru_maxrss) / 1024.0);
-  timer.Print();
+  timer.Print(stdout);
   return 0;
 }
