@@ -187,8 +187,9 @@ TEST(SGraphRemoveKeyframe, NeverFusesIntoAKeptLoop) {
 class SGraphPlaneObservers : public ::testing::Test {
  protected:
   // StraightLine's line, as far as a store of 16 lets it grow; every keyframe sees wall
-  // `seen_by_all` when added; keyframe `only` alone sees wall `seen_once`. ids[i]: keyframe i's.
-  void Build(std::uint32_t count, std::uint32_t only) {
+  // `seen_by_all` when added; keyframe `only` alone sees wall `seen_once` (`times` times: two
+  // segments of one wall in one scan are two observations). ids[i]: keyframe i's.
+  void Build(std::uint32_t count, std::uint32_t only, int times = 1) {
     ASSERT_TRUE(g.Init(SmallStore()));
     seen_by_all = *g.AddPlane(all.n, all.d, PlaneClass::kWall);
     seen_once = *g.AddPlane(once.n, once.d, PlaneClass::kWall);
@@ -205,7 +206,7 @@ class SGraphPlaneObservers : public ::testing::Test {
       }
       ids.push_back(*k);
       Observe(*k, seen_by_all, all);
-      if (i == only) Observe(*k, seen_once, once);
+      for (int t = 0; t < times && i == only; ++t) Observe(*k, seen_once, once);
     }
   }
   void Observe(std::uint32_t k, std::uint32_t plane, const TruePlane& truth) {
@@ -236,21 +237,24 @@ TEST_F(SGraphPlaneObservers, ARemovalOnRequestNeverTakesTheLastObserver) {
   EXPECT_EQ(g.stats().planes_unobserved, 0u);
 }
 
-TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverOnlyWhenNothingElseIsLeft) {
+TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverAfterTheOthersOfItsTier) {
   // Keyframe 1 would be the first victim (hops all alike: the oldest wins the tie), but it is
-  // the only one to see `seen_once`: 40 keyframes through a store of 16 leave it in place.
-  ASSERT_NO_FATAL_FAILURE(Build(40, 1));
+  // the only one to see `seen_once` (twice): 40 keyframes through a store of 16 leave it.
+  ASSERT_NO_FATAL_FAILURE(Build(40, 1, 2));
   EXPECT_GT(g.stats().sparsified, 20u);
   EXPECT_TRUE(g.keyframe_active(ids[1]));
   EXPECT_EQ(g.keyframe_stamp(ids[1]), 1.0);
-  EXPECT_EQ(g.plane(seen_once).live_observations, 1u);
+  EXPECT_EQ(g.plane(seen_once).live_observations, 2u);
   EXPECT_EQ(g.stats().planes_unobserved, 0u);
 
   // Every keyframe the only one to see its wall: sparsification must still make room, and the
-  // walls it leaves unmeasured are counted, keep their estimate, and have no marginal.
+  // walls it leaves unmeasured are counted, keep their estimate, and have no marginal. Keyframe
+  // 5 sees no wall but closes a loop to the origin: a loop weighs more than a wall seen once,
+  // so it stays while walls' only observers go.
   SGraph h;
   ASSERT_TRUE(h.Init(SmallStore()));
   std::vector<std::uint32_t> walls;
+  std::vector<double> offsets_m;
   std::uint32_t prev = 0;
   const std::size_t count = 24;
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -264,8 +268,15 @@ TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverOnlyWhenNothingElse
       ASSERT_TRUE(h.AddRelativePose(prev, *k, step, OdometryInformation(), RelativePoseKind::kOdometry));
     }
     prev = *k;
+    if (i == 5) {
+      Eigen::Isometry3d five = Eigen::Isometry3d::Identity();
+      five.translation().x() = 5;
+      ASSERT_TRUE(h.AddRelativePose(0, *k, five, LoopInformation(), RelativePoseKind::kLoopClosure));
+    }
     const TruePlane wall{-Eigen::Vector3d::UnitX(), i + 2.0};  // 2 m ahead of keyframe i
+    if (i == 5) continue;
     walls.push_back(*h.AddPlane(wall.n, wall.d, PlaneClass::kWall));
+    offsets_m.push_back(wall.d);
     ASSERT_TRUE(h.AddPlaneObservation(*k, walls.back(), Measure(wall, T, rng, 0.01)));
   }
   const std::size_t removed = h.stats().sparsified;
@@ -277,17 +288,21 @@ TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverOnlyWhenNothingElse
     if (p.live_observations > 0) continue;
     ++unobserved;
     EXPECT_TRUE(p.active);
-    EXPECT_NEAR(p.d, static_cast<double>(i) + 2.0, 1e-9);  // never moved: nothing measures it
+    EXPECT_NEAR(p.d, offsets_m[i], 1e-9);  // never moved: nothing measures it
     const std::array<std::uint32_t, 1> one{walls[i]};
     std::array<Eigen::Matrix3d, 1> covariance{};
     const Status s = h.PlaneMarginals(one, covariance);
     ASSERT_FALSE(s);
     EXPECT_EQ(s.error().code, Errc::kInvalidArgument);
     SGraphSolveJob job;
-    EXPECT_EQ(h.BeginPlaneMarginals(job, one, PlaneEvidence::kOwn).error().code,
-              Errc::kInvalidArgument);
+    const Status begun = h.BeginPlaneMarginals(job, one, PlaneEvidence::kOwn);
+    ASSERT_FALSE(begun);
+    EXPECT_EQ(begun.error().code, Errc::kInvalidArgument);
   }
   EXPECT_EQ(unobserved, removed);
+  EXPECT_EQ(h.stats().sparsified_with_loops, 0u);
+  EXPECT_TRUE(h.keyframe_active(5));
+  EXPECT_EQ(h.keyframe_stamp(5), 5.0);
   const std::array<std::uint32_t, 1> newest{walls.back()};
   std::array<Eigen::Matrix3d, 1> covariance{};
   ASSERT_TRUE(h.PlaneMarginals(newest, covariance));  // the observed ones still have one

@@ -61,6 +61,7 @@ TEST(CollabOptions, BadValuesAreRefusedWithAReason) {
         {"--run", "/r", "--max-keyframes", "0"},
         {"--run", "/r", "--max-keyframes", "12.5"},
         {"--run", "/r", "--max-keyframes", "-3"},
+        {"--run", "/r", "--max-keyframes", "65537"},
         {"--run", "/r", "--max-keyframes"},
         {"--run", "/r", "--mode", "magic"},
         {"--run", "/r", "--summary"},

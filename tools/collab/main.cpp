@@ -73,7 +73,8 @@ int main(int argc, char** argv) {
     const fs::path dir = fs::path(o.run) / ("robot" + std::to_string(i + 1));
     if (!fs::exists(dir / "velodyne.pcap")) break;
     const StartDelay delay = ResolveStartDelay(i + 1, mission_delays_s, o.delays_s);
-    auto robot = OpenRobot(dir.string(), i, delay.delay_s, o.max_keyframes, o.session, error);
+    auto robot = OpenRobot(dir.string(), i, delay.delay_s, o.max_keyframes, o.timing, o.session,
+                           error);
     if (!robot) {
       std::fprintf(stderr, "collab: %s\n", error.c_str());
       return 1;

@@ -56,8 +56,9 @@ bool ParseOptions(int argc, char** argv, Options& o, std::string& error) {
       if (!Number(v, o.until_s) || !(o.until_s > 0)) return fail(a + " takes seconds > 0");
     } else if (a == "--max-keyframes") {
       // A whole number of keyframes; the graph's own validation judges the value (OpenRobot).
-      if (!Number(v, number) || !(number >= 1) || number > 1e7 || number != std::floor(number))
-        return fail(a + " takes a whole number of keyframes >= 1");
+      // At most 65,536: every store sized from it is allocated at Init, for every robot.
+      if (!Number(v, number) || !(number >= 1) || number > 65536 || number != std::floor(number))
+        return fail(a + " takes a whole number of keyframes from 1 to 65536");
       o.max_keyframes = static_cast<std::size_t>(number);
     } else if (a == "--delay-s") {
       // ROBOT=SECONDS: that robot starts later in mission time (a late joiner when longer than

@@ -46,12 +46,14 @@ std::unique_ptr<Robot> OpenRobot(const std::string& dir_name,
                                  int index,
                                  double delay_s,
                                  std::size_t max_keyframes,
+                                 bool timed,
                                  core::CollabSessionConfig session_config,
                                  std::string& error) {
   const fs::path dir(dir_name);
   auto r = std::make_unique<Robot>();
   r->index = index;
   r->delay_s = delay_s;
+  r->timed = timed;
   r->scans = drivers::velodyne::RecordedScans::Open((dir / "velodyne.pcap").string());
   auto candump = drivers::can_odometry::CandumpFileReader::Open((dir / "odometry.log").c_str());
   if (!r->scans || !candump) {
@@ -60,7 +62,12 @@ std::unique_ptr<Robot> OpenRobot(const std::string& dir_name,
   }
   r->candump.emplace(std::move(*candump));
   core::LocalMapperConfig config;
-  if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;  // validated by Init
+  if (max_keyframes > 0) {  // validated by Init
+    // The factor store grows with it, at the defaults' ratio (16 a keyframe), never below.
+    const std::size_t per_keyframe = config.graph.max_factors / config.graph.max_keyframes;
+    config.graph.max_factors = std::max(config.graph.max_factors, per_keyframe * max_keyframes);
+    config.graph.max_keyframes = max_keyframes;
+  }
   session_config.robot = r->id();
   Status s = r->mapper.Init(config);
   if (s) s = r->session.Init(session_config, config.graph, -config.base_height_m);
@@ -95,6 +102,11 @@ void ProcessNextScan(Robot& r) {
   core::LidarScanView view{points, times, r.pending->start_time.seconds_since_epoch(),
                            r.pending->end_time.seconds_since_epoch()};
   FeedOdometry(r, view.end_s + 0.05);
+  if (!r.timed) {
+    static_cast<void>(r.mapper.AddScan(view));
+    Advance(r);
+    return;
+  }
   const auto sweep_start = std::chrono::steady_clock::now();
   const auto outcome = r.mapper.AddScan(view, &r.timing);
   if (outcome && *outcome == core::ScanOutcome::kNotKeyframe) {
@@ -105,7 +117,10 @@ void ProcessNextScan(Robot& r) {
   if (r.mapper.stats().full_solves_begun != r.solves_begun) {
     r.solves_begun = r.mapper.stats().full_solves_begun;
     if (core::SGraphSolveJob* job = r.mapper.background_solve()) {
-      if (r.solver.joinable()) r.solver.join();  // the previous job was applied before this began
+      // The previous job was applied before this one began, but its thread may not have
+      // started yet (the mapper then ran that job itself): it may claim this one, and the new
+      // thread then finds it claimed. Either way one thread runs it.
+      if (r.solver.joinable()) r.solver.join();
       r.solver = std::jthread([job] {
         if (job->TryClaim()) job->Run();
       });

@@ -65,22 +65,26 @@ struct Robot {
   std::vector<core::MergeLogEntry> merge_log;
   KeyframeBaselineState baseline;
   std::vector<StampedPose> truth;  ///< ground_truth.tum as read (empty when absent)
-  /// Its mapper's per-stage keyframe timing (--timing prints it).
+  /// --timing: its mapper's per-stage keyframe timing is recorded, and each full solve its
+  /// mapper begins runs on a thread of its own, as the node's solver thread does. Off, the
+  /// mapper runs each at the keyframe it applies it at, on the mission's thread: a solve then
+  /// never competes with the robots for the 2 cores, so no time limit (the local solve's 50 ms,
+  /// a full solve's 2 s) is reached for want of a core, and the maps are the same run after run.
+  bool timed = false;
   KeyframeTiming timing;
-  /// The full solve its mapper began, run on a thread of its own as the node's solver thread
-  /// does (the map does not depend on it: the mapper applies it at a fixed keyframe, running it
-  /// there if it is not done). Declared last: joined before the mapper goes.
+  /// Declared last: joined before the mapper goes.
   std::uint64_t solves_begun = 0;
   std::jthread solver;
 };
 
 /// Opens robot `index`'s recording in `dir` (velodyne.pcap, odometry.log, ground_truth.tum) and
 /// initialises its mapper, session and baseline graph. nullptr with `error` set on failure.
-/// `max_keyframes`: the S-Graph's keyframe store (0: the mapper's default).
+/// `max_keyframes`: the S-Graph's keyframe store (0: the mapper's default); `timed`: Robot::timed.
 std::unique_ptr<Robot> OpenRobot(const std::string& dir,
                                  int index,
                                  double delay_s,
                                  std::size_t max_keyframes,
+                                 bool timed,
                                  core::CollabSessionConfig session_config,
                                  std::string& error);
 

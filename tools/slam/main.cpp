@@ -219,7 +219,9 @@ int main(int argc, char** argv) {
       timer.Sweep(std::chrono::duration<double, std::milli>(Clock::now() - sweep_start).count());
     // A full solve begun at this keyframe runs on its own thread, as in the node; the map does
     // not depend on it (the mapper applies it at a fixed keyframe, running it there if need be).
-    // One thread per job begun (the previous job was applied before this one began).
+    // One thread per job begun. The previous job was applied before this one began, but its
+    // thread may not have started (the mapper then ran it itself) and may claim this one: the
+    // new thread then finds it claimed. Either way one thread runs it.
     if (mapper.stats().full_solves_begun != solves_begun) {
       solves_begun = mapper.stats().full_solves_begun;
       if (core::SGraphSolveJob* job = mapper.background_solve()) {

@@ -131,12 +131,13 @@ void Distiller::FindEligible(const SGraph& graph) {
     }
   }
   eligible_.clear();
+  unobserved_ = 0;
   for (std::uint32_t id = 0; id < graph.plane_slots() && id < wall_slot_.size(); ++id) {
     const MapPlane p = graph.plane(id);
     if (!p.active || p.plane_class != PlaneClass::kWall) continue;
     if (p.observations < config_.min_wall_observations && needed_[id] == 0) continue;
     if (p.live_observations == 0) {
-      ++stats_.walls_unobserved;
+      ++unobserved_;  // counted by Update (BeginMarginals looks too)
       continue;
     }
     Eigen::LLT<Eigen::Matrix3d> llt(p.information);
@@ -215,6 +216,7 @@ bool Distiller::Update(const SGraph& graph, const PlaneMapper& planes, Marginals
   const bool own = config_.marginal_covariances && graph.estimates_hold_priors();
   // The walls to share, then (kNow) their marginal covariances from one factorisation.
   FindEligible(graph);
+  stats_.walls_unobserved += unobserved_;
   if (config_.marginal_covariances && !background) {
     if (own && eligible_.empty())
       ForgetOwnEstimates();  // no job: nothing of an older one goes out as now

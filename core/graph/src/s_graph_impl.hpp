@@ -57,6 +57,9 @@ struct PlaneNode {
   MapPlane info;
   bool in_problem = false;
   bool window_free = false;  // moves in the current local solve (CollectWindow)
+  // Sparsify's scratch (MarkLastObservers): the one keyframe seen observing it, or kNone.
+  std::int32_t only_observer = kNone;
+  bool observers_two_or_more = false;
   // Its observations by keyframes the local solve holds, summed into one quadratic in
   // x = [n; d] (s_graph_solve.cpp): x' H x - 2 g' x. The sum holds every observation by a
   // keyframe stamped before held_before_s, and is current while held_epoch is the graph's
@@ -484,6 +487,9 @@ struct SGraph::Impl {
   bool RemovalLosesNothing(std::uint32_t v) const;
   // Whether v holds the last observation of some plane.
   bool LastObserverOfAPlane(std::uint32_t v) const;
+  // Sets every keyframe's last_observer: whether it is the only keyframe left observing some
+  // plane.
+  void MarkLastObservers();
   // The oldest keyframe of the local window (kNone when fewer keyframes than the window).
   std::int32_t WindowStart() const;
   // A relative factor's measurement T_a_b and information, as its residual holds them.

@@ -142,6 +142,30 @@ bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) const {
   return !LastObserverOfAPlane(v);
 }
 
+void SGraph::Impl::MarkLastObservers() {
+  // Which keyframes are the only ones left that observe some plane (a keyframe may observe one
+  // plane twice: two segments of a wall). One pass over the factors, not one per candidate;
+  // the scratch lives in the nodes (sized at Init).
+  for (std::size_t k = 0; k < keyframe_high_water; ++k) keyframes[k].last_observer = false;
+  for (std::size_t p = 0; p < plane_count; ++p) {
+    planes[p].only_observer = kNone;
+    planes[p].observers_two_or_more = false;
+  }
+  for (std::size_t i = 0; i < factor_high_water; ++i) {
+    const FactorRecord& f = factors[i];
+    if (!f.active || f.kind != FactorKind::kPlane) continue;
+    PlaneNode& p = planes[f.b];
+    if (p.only_observer == kNone)
+      p.only_observer = static_cast<std::int32_t>(f.a);
+    else if (p.only_observer != static_cast<std::int32_t>(f.a))
+      p.observers_two_or_more = true;
+  }
+  for (std::size_t p = 0; p < plane_count; ++p) {
+    if (planes[p].only_observer != kNone && !planes[p].observers_two_or_more)
+      keyframes[static_cast<std::size_t>(planes[p].only_observer)].last_observer = true;
+  }
+}
+
 bool SGraph::Impl::LastObserverOfAPlane(std::uint32_t v) const {
   // Plane observations are dropped with their keyframe, never carried: a plane whose every
   // live observation is v's would be left unmeasured (held where it is, with no marginal).
@@ -162,19 +186,12 @@ bool SGraph::Impl::Sparsify() {
   if (origin == kNone || newest == kNone) return false;
   const std::int32_t window_start = WindowStart();
   if (window_start == kNone) return false;
-  // Which keyframes hold some plane's only live observation: removing one leaves that plane
-  // unmeasured, so they go last. (One pass over the factors, not one per candidate.)
-  for (std::size_t k = 0; k < keyframe_high_water; ++k) keyframes[k].last_observer = false;
-  for (std::size_t i = 0; i < factor_high_water; ++i) {
-    const FactorRecord& f = factors[i];
-    if (f.active && f.kind == FactorKind::kPlane && planes[f.b].info.live_observations == 1)
-      keyframes[f.a].last_observer = true;
-  }
+  MarkLastObservers();
   // The victim, cheapest loss first: no loop closure on it; then loops that can be carried
-  // (a hop with a measurement to carry them through), fewest first; then the rest. Every
-  // keyframe that is some plane's last observer after all those. Within that, the shortest hop
-  // between its neighbours (the most redundant keyframe). Never the origin, never in the local
-  // window.
+  // (a hop with a measurement to carry them through), fewest first; then the rest. Within each
+  // of those, a keyframe that is some plane's last observer after the others (a loop weighs
+  // more than a plane seen once), then the shortest hop between its neighbours (the most
+  // redundant keyframe). Never the origin, never in the local window.
   std::int32_t victim = kNone;
   int best_tier = 6;
   std::uint32_t best_loops = 0;
@@ -187,7 +204,7 @@ bool SGraph::Impl::Sparsify() {
         !node.information_from_prev.isZero(0.0) ||
         !keyframes[static_cast<std::size_t>(node.next)].information_from_prev.isZero(0.0);
     const int tier =
-        (node.last_observer ? 3 : 0) + (node.loop_factors == 0 ? 0 : (carriable ? 1 : 2));
+        2 * (node.loop_factors == 0 ? 0 : (carriable ? 1 : 2)) + (node.last_observer ? 1 : 0);
     const double hop = (Pose(static_cast<std::uint32_t>(node.prev)).translation() -
                         Pose(static_cast<std::uint32_t>(node.next)).translation())
                            .norm();

@@ -136,6 +136,7 @@ class Distiller {
   bool CollectMarginals();
   // The walls to share now, into eligible_ (and needed_).
   void FindEligible(const SGraph& graph);
+  std::uint64_t unobserved_ = 0;  ///< walls FindEligible left out: nothing measures them
   // Computes the marginals of eligible_ now, into marginal_.
   void MarginalsNow(const SGraph& graph);
   // Takes computed covariances (one per id) into marginal_; a size mismatch is a failure.
