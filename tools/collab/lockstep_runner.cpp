@@ -44,7 +44,7 @@ MissionRun RunLockStep(Mission& mission,
     ProcessNextScan(*next);
   }
   for (auto& r : mission.robots) {
-    if (r->solver.joinable()) r->solver.join();  // its last background solve, done
+    r->solver.Join();  // its last background solve, done
     static_cast<void>(r->mapper.Finish());
   }
   mission.Exchange(run.mission_time_s);

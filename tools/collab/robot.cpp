@@ -114,18 +114,7 @@ void ProcessNextScan(Robot& r) {
                                                              sweep_start)
                        .count());
   }
-  if (r.mapper.stats().full_solves_begun != r.solves_begun) {
-    r.solves_begun = r.mapper.stats().full_solves_begun;
-    if (core::SGraphSolveJob* job = r.mapper.background_solve()) {
-      // The previous job was applied before this one began, but its thread may not have
-      // started yet (the mapper then ran that job itself): it may claim this one, and the new
-      // thread then finds it claimed. Either way one thread runs it.
-      if (r.solver.joinable()) r.solver.join();
-      r.solver = std::jthread([job] {
-        if (job->TryClaim()) job->Run();
-      });
-    }
-  }
+  r.solver.Follow(r.mapper);
   Advance(r);
 }
 

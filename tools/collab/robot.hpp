@@ -12,7 +12,6 @@
 #include <optional>
 #include <set>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -26,6 +25,7 @@
 #include "msgraphs/drivers/can_odometry/odometry_stream.hpp"
 #include "msgraphs/drivers/velodyne/recorded_scans.hpp"
 #include "msgraphs/tools/keyframe_timing.hpp"
+#include "msgraphs/tools/solver_thread.hpp"
 #include "msgraphs/tools/tum.hpp"
 
 namespace msgraphs::tools::collab {
@@ -72,9 +72,7 @@ struct Robot {
   /// a full solve's 2 s) is reached for want of a core, and the maps are the same run after run.
   bool timed = false;
   KeyframeTiming timing;
-  /// Declared last: joined before the mapper goes.
-  std::uint64_t solves_begun = 0;
-  std::jthread solver;
+  SolverThread solver;  ///< declared last: joined before the mapper goes
 };
 
 /// Opens robot `index`'s recording in `dir` (velodyne.pcap, odometry.log, ground_truth.tum) and

@@ -41,6 +41,7 @@
 #include "msgraphs/tools/ate.hpp"
 #include "msgraphs/tools/candump_odometry.hpp"
 #include "msgraphs/tools/keyframe_timing.hpp"
+#include "msgraphs/tools/solver_thread.hpp"
 #include "msgraphs/tools/truth_pairing.hpp"
 #include "msgraphs/tools/tum.hpp"
 #include "truth.hpp"
@@ -165,8 +166,7 @@ int main(int argc, char** argv) {
   if (fs::exists(fs::path(run) / "world.world"))
     world = sim::LoadWorld((fs::path(run) / "world.world").string(), world_error);
   core::LocalMapper mapper;
-  std::jthread solver;  // the background full solve's runner (joined before the mapper goes)
-  std::uint64_t solves_begun = 0;
+  tools::SolverThread solver;  // the background full solve's runner (joined before the mapper goes)
   if (auto s = mapper.Init(config); !s) {
     std::fprintf(stderr, "slam: %s\n", s.error().detail);
     return 1;
@@ -217,20 +217,7 @@ int main(int argc, char** argv) {
     const auto outcome = mapper.AddScan(view, &timer);
     if (outcome && *outcome == core::ScanOutcome::kNotKeyframe)
       timer.Sweep(std::chrono::duration<double, std::milli>(Clock::now() - sweep_start).count());
-    // A full solve begun at this keyframe runs on its own thread, as in the node; the map does
-    // not depend on it (the mapper applies it at a fixed keyframe, running it there if need be).
-    // One thread per job begun. The previous job was applied before this one began, but its
-    // thread may not have started (the mapper then ran it itself) and may claim this one: the
-    // new thread then finds it claimed. Either way one thread runs it.
-    if (mapper.stats().full_solves_begun != solves_begun) {
-      solves_begun = mapper.stats().full_solves_begun;
-      if (core::SGraphSolveJob* job = mapper.background_solve()) {
-        if (solver.joinable()) solver.join();
-        solver = std::jthread([job] {
-          if (job->TryClaim()) job->Run();
-        });
-      }
-    }
+    solver.Follow(mapper);  // a full solve begun at this keyframe: on its own thread
     const core::ScanMatchRecord& m = mapper.last_scan_match();
     if (matches != nullptr && outcome && *outcome == core::ScanOutcome::kKeyframe && m.attempted) {
       const Eigen::Quaterniond q(m.T_from_to.linear());
@@ -248,7 +235,7 @@ int main(int argc, char** argv) {
                                                     : "");
     }
   }
-  if (solver.joinable()) solver.join();
+  solver.Join();
   static_cast<void>(mapper.Finish());
   if (matches != nullptr && std::fclose(matches) != 0) {
     std::fprintf(stderr, "slam: writing %s failed\n", matches_path.c_str());

@@ -48,7 +48,7 @@ struct KeyframeNode {
   Eigen::Isometry3d measurement_from_prev = Eigen::Isometry3d::Identity();
   Matrix6d information_from_prev = Matrix6d::Zero();
   bool active = false;
-  bool last_observer = false;  // Sparsify's scratch: the only observer left of some plane
+  bool last_observer = false;  // MarkLastObservers: the only observer left of some plane
 };
 
 struct PlaneNode {
@@ -57,7 +57,7 @@ struct PlaneNode {
   MapPlane info;
   bool in_problem = false;
   bool window_free = false;  // moves in the current local solve (CollectWindow)
-  // Sparsify's scratch (MarkLastObservers): the one keyframe seen observing it, or kNone.
+  // MarkLastObservers' scratch: the one keyframe seen observing it, or kNone.
   std::int32_t only_observer = kNone;
   bool observers_two_or_more = false;
   // Its observations by keyframes the local solve holds, summed into one quadratic in
@@ -484,9 +484,7 @@ struct SGraph::Impl {
   void RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t> keep_factors = {});
   // Whether removing v would carry every loop on it and join its neighbours, and leave every
   // plane it sees observed (no constraint dropped): what a removal on request requires.
-  bool RemovalLosesNothing(std::uint32_t v) const;
-  // Whether v holds the last observation of some plane.
-  bool LastObserverOfAPlane(std::uint32_t v) const;
+  bool RemovalLosesNothing(std::uint32_t v);
   // Sets every keyframe's last_observer: whether it is the only keyframe left observing some
   // plane.
   void MarkLastObservers();

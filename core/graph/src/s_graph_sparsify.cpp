@@ -128,7 +128,7 @@ std::int32_t SGraph::Impl::WindowStart() const {
   return window_start;
 }
 
-bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) const {
+bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) {
   const auto p = static_cast<std::uint32_t>(keyframes[v].prev);
   const auto n = static_cast<std::uint32_t>(keyframes[v].next);
   const Hop a = MakeHop(keyframes[v]), b = MakeHop(keyframes[n]);
@@ -139,7 +139,10 @@ bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) const {
       continue;
     if (Route(f.a == v ? f.b : f.a, p, n, a, b) == Via::kNowhere) return false;
   }
-  return !LastObserverOfAPlane(v);
+  // Plane observations are dropped with their keyframe, never carried: a plane whose every
+  // live observation is v's would be left unmeasured (held where it is, with no marginal).
+  MarkLastObservers();
+  return !keyframes[v].last_observer;
 }
 
 void SGraph::Impl::MarkLastObservers() {
@@ -164,22 +167,6 @@ void SGraph::Impl::MarkLastObservers() {
     if (planes[p].only_observer != kNone && !planes[p].observers_two_or_more)
       keyframes[static_cast<std::size_t>(planes[p].only_observer)].last_observer = true;
   }
-}
-
-bool SGraph::Impl::LastObserverOfAPlane(std::uint32_t v) const {
-  // Plane observations are dropped with their keyframe, never carried: a plane whose every
-  // live observation is v's would be left unmeasured (held where it is, with no marginal).
-  for (std::size_t i = 0; i < factor_high_water; ++i) {
-    const FactorRecord& f = factors[i];
-    if (!f.active || f.kind != FactorKind::kPlane || f.a != v) continue;
-    std::uint32_t by_v = 0;
-    for (std::size_t j = 0; j < factor_high_water; ++j) {
-      const FactorRecord& g = factors[j];
-      if (g.active && g.kind == FactorKind::kPlane && g.a == v && g.b == f.b) ++by_v;
-    }
-    if (planes[f.b].info.live_observations <= by_v) return true;
-  }
-  return false;
 }
 
 bool SGraph::Impl::Sparsify() {

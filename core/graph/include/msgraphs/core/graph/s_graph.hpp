@@ -29,8 +29,8 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <span>
 
 #include "msgraphs/base/expected.hpp"
@@ -162,9 +162,9 @@ struct SGraphStats {
   /// Keyframes removed on request (RemoveKeyframe), not counted in `sparsified`.
   std::uint64_t removed_keyframes = 0;
   /// Planes whose last live observation went: with its keyframe, by sparsification at a full
-  /// store (which takes a plane's last observer only when every candidate of the same loop tier
-  /// is one; a removal on request never does), or by RemoveFactor. Such a plane keeps its estimate; PlaneMarginals
-  /// refuses it (MapPlane::live_observations).
+  /// store (which takes a plane's last observer only when every candidate of the same loop
+  /// tier is one; a removal on request never does), or by RemoveFactor. Such a plane keeps its
+  /// estimate; PlaneMarginals refuses it (MapPlane::live_observations).
   std::uint64_t planes_unobserved = 0;
   std::size_t planes = 0, rooms = 0, floors = 0;
   std::size_t factors = 0, factors_peak = 0;
