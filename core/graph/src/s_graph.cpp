@@ -80,6 +80,7 @@ Status SGraph::Init(const SGraphConfig& config) {
   m.free_factor_slots.clear();
   m.free_factor_slots.reserve(config.max_factors);
   m.factor_high_water = m.active_factors = 0;
+  m.residual_index.Init(config.max_factors);
   m.retired_costs.reserve(config.max_factors);
   m.plane_only_factors.clear();
   m.plane_only_factors.reserve(config.max_factors);
@@ -94,7 +95,8 @@ Status SGraph::Init(const SGraphConfig& config) {
       m.snapshot.size() * sizeof(double) +
       (m.free_keyframe_slots.capacity() + m.free_factor_slots.capacity() +
        m.plane_only_factors.capacity()) *
-          sizeof(std::int32_t);
+          sizeof(std::int32_t) +
+      m.residual_index.bytes();
   return Ok();
 }
 
@@ -286,8 +288,7 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
   auto* functor = new sgraph::PlaneResidual{z.basis_u, z.basis_v, z.d, sqrt_information};
   auto* cost = new sgraph::PlaneCost(functor);
   KeyframeNode& k = m.keyframes[keyframe];
-  m.factors[static_cast<std::size_t>(*slot)].id =
-      m.problem->AddResidualBlock(cost, m.huber_plane.get(), k.q, k.t, p.n, p.d);
+  m.Bind(*slot, m.problem->AddResidualBlock(cost, m.huber_plane.get(), k.q, k.t, p.n, p.d));
   ++m.stats.plane_factors;
   // Information of this observation about the map plane: the Jacobian of the measurement
   // coordinates (u_m.n_k, v_m.n_k, d_k) with respect to the map plane's (alpha, beta, delta_d),
@@ -383,7 +384,7 @@ Status SGraph::UpdateRoom(std::uint32_t id, const MapRoom& updated) {
     block =
         m.problem->AddResidualBlock(cost, m.huber_room.get(), r.c, W(0).n, W(0).d, W(1).n, W(1).d);
   }
-  m.factors[static_cast<std::size_t>(*slot)].id = block;
+  m.Bind(*slot, block);
   ++m.stats.room_factors;
   r.factor = *slot;
   const bool active = r.info.active;
@@ -424,8 +425,8 @@ Status SGraph::AddWallWall(std::uint32_t a, std::uint32_t b) {
   if (!slot) return slot.error();
   auto* cost = new ceres::AutoDiffCostFunction<sgraph::WallWallResidual, 4, 3, 1, 3, 1>(
       new sgraph::WallWallResidual{1.0 / m.config.wall_wall_sigma});
-  m.factors[static_cast<std::size_t>(*slot)].id = m.problem->AddResidualBlock(
-      cost, m.huber_plane.get(), m.planes[a].n, m.planes[a].d, m.planes[b].n, m.planes[b].d);
+  m.Bind(*slot, m.problem->AddResidualBlock(
+      cost, m.huber_plane.get(), m.planes[a].n, m.planes[a].d, m.planes[b].n, m.planes[b].d));
   ++m.stats.wall_wall_factors;
   return Ok();
 }
@@ -466,8 +467,7 @@ Expected<std::uint32_t> SGraph::AddPlanePrior(const PlanePrior& prior) {
   WallBasis(prior.normal, u, v);
   auto* cost = new ceres::AutoDiffCostFunction<sgraph::PlanePriorResidual, 3, 3, 1>(
       new sgraph::PlanePriorResidual{u, v, prior.d, Eigen::Matrix3d(info_llt.matrixU())});
-  m.factors[static_cast<std::size_t>(*slot)].id =
-      m.problem->AddResidualBlock(cost, m.huber_plane.get(), p.n, p.d);
+  m.Bind(*slot, m.problem->AddResidualBlock(cost, m.huber_plane.get(), p.n, p.d));
   ++m.stats.plane_prior_factors;
   m.prior_pull = true;
   ++m.prior_adds;
@@ -505,8 +505,7 @@ Status SGraph::AddFloorRoom(std::uint32_t room) {
   const Eigen::Vector2d offset(m.floor_c[0] - r.c[0], m.floor_c[1] - r.c[1]);
   auto* cost = new ceres::AutoDiffCostFunction<sgraph::FloorRoomResidual, 2, 2, 2>(
       new sgraph::FloorRoomResidual{offset, 1.0 / m.config.floor_room_sigma_m});
-  m.factors[static_cast<std::size_t>(*slot)].id =
-      m.problem->AddResidualBlock(cost, nullptr, m.floor_c, r.c);
+  m.Bind(*slot, m.problem->AddResidualBlock(cost, nullptr, m.floor_c, r.c));
   ++m.stats.floor_factors;
   r.floor_factor = *slot;
   return Ok();
@@ -556,9 +555,12 @@ Status SGraph::PlaneMarginals(std::span<const std::uint32_t> ids,
       return Error{Errc::kInvalidArgument, "plane marginals: the plane has no observation left"};
     planes.push_back({p.n, p.d, p.info.basis_u, p.info.basis_v});
   }
-  // Every block but the origin's is variable in the graph's problem (local solves move a
-  // window problem of their own), so the covariance is over the whole graph.
-  return sgraph::PlaneCovariances(*m.problem, planes, covariances);
+  // Every block but the origin's is variable (local solves move a window problem of their
+  // own), so the covariance is over the whole graph, handed to Ceres in slot order.
+  m.BuildFullProblem();
+  const Status s = sgraph::PlaneCovariances(*m.window, planes, covariances);
+  m.window.reset();
+  return s;
 }
 
 std::size_t SGraph::room_slots() const { return impl_->room_count; }

@@ -132,31 +132,23 @@ Status SGraph::CopyIntoJob(SGraphSolveJob& job, PlaneEvidence evidence) const {
     }
     return nullptr;
   };
-  // kOwn: the plane priors' residual blocks, sorted, to leave out (the job was sized from the
-  // same config: every factor fits).
-  j.left_out.clear();
-  if (evidence == PlaneEvidence::kOwn) {
-    for (std::size_t f = 0; f < m.factor_high_water; ++f) {
-      const FactorRecord& rec = m.factors[f];
-      if (!rec.active || rec.kind != FactorKind::kPlanePrior) continue;
-      if (j.left_out.size() == j.left_out.capacity())
-        return Error{Errc::kCapacityExceeded, "solve job sized for fewer factors than the graph"};
-      j.left_out.push_back(rec.id);
-    }
-    std::sort(j.left_out.begin(), j.left_out.end(), std::less<>());
-  }
+  // The residual blocks in factor-slot order (not the graph's problem's, a history of
+  // additions and removals): a copy of the same records is the same problem for Ceres. A kOwn
+  // copy leaves the plane priors out.
   j.priors_left_out = 0;
   j.priors_at_copy = m.stats.plane_prior_factors;
   j.prior_adds_at_copy = m.prior_adds;
   j.own_solve_usable = j.own_solve_converged = true;
-  m.problem->GetResidualBlocks(&j.ids);
   j.residuals.clear();
   j.refs.clear();
-  for (ceres::ResidualBlockId id : j.ids) {
-    if (!j.left_out.empty() && std::binary_search(j.left_out.begin(), j.left_out.end(), id, std::less<>())) {
+  for (std::size_t f = 0; f < m.factor_high_water; ++f) {
+    const FactorRecord& rec = m.factors[f];
+    if (!rec.active) continue;
+    if (evidence == PlaneEvidence::kOwn && rec.kind == FactorKind::kPlanePrior) {
       ++j.priors_left_out;
       continue;
     }
+    const ceres::ResidualBlockId id = rec.id;
     JobResidual r;
     r.cost = m.problem->GetCostFunctionForResidualBlock(id);
     r.loss = m.problem->GetLossFunctionForResidualBlock(id);
@@ -172,6 +164,8 @@ Status SGraph::CopyIntoJob(SGraphSolveJob& job, PlaneEvidence evidence) const {
     r.count = static_cast<std::uint32_t>(m.scratch_blocks.size());
     j.residuals.push_back(r);
   }
+  if (j.residuals.size() + j.priors_left_out != static_cast<std::size_t>(m.problem->NumResidualBlocks()))
+    return Error{Errc::kInvalidArgument, "a residual block of the graph has no factor record"};
   j.solve_first = evidence == PlaneEvidence::kOwn && (j.priors_left_out > 0 || m.prior_pull);
   Impl::Borrower* borrower = m.TakeBorrower();
   if (borrower == nullptr)

@@ -67,6 +67,7 @@ void SGraph::Impl::UpdateHeldSums() {
       break;
     }
     problem->GetResidualBlocksForParameterBlock(node.q, &scratch_residuals);
+    SortBySlot(scratch_residuals);  // a sum's rounding must not follow Ceres' hash order
     for (ceres::ResidualBlockId id : scratch_residuals) {
       const auto* cost =
           dynamic_cast<const sgraph::PlaneCost*>(problem->GetCostFunctionForResidualBlock(id));
@@ -96,6 +97,7 @@ void SGraph::Impl::RebuildHeldSum(PlaneNode& plane) {
   plane.held_g.setZero();
   plane.held_observations = 0;
   problem->GetResidualBlocksForParameterBlock(plane.n, &scratch_residuals);
+  SortBySlot(scratch_residuals);  // a sum's rounding must not follow Ceres' hash order
   for (ceres::ResidualBlockId id : scratch_residuals) {
     const auto* cost =
         dynamic_cast<const sgraph::PlaneCost*>(problem->GetCostFunctionForResidualBlock(id));

@@ -17,9 +17,11 @@
 #include <span>
 #include <vector>
 
+#include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
 #include "s_graph_factors.hpp"
+#include "s_graph_residual_index.hpp"
 
 namespace msgraphs::core {
 namespace sgraph {
@@ -188,6 +190,15 @@ struct SGraph::Impl {
   std::vector<FactorRecord> factors;
   std::vector<std::int32_t> free_factor_slots;
   std::size_t factor_high_water = 0, active_factors = 0;
+  // The slot of every residual block in `problem` (s_graph_residual_index.hpp): what every
+  // problem handed to Ceres is ordered by.
+  sgraph::ResidualIndex residual_index;
+  // Records the residual block Ceres made for factor `slot`.
+  void Bind(std::int32_t slot, ceres::ResidualBlockId id) {
+    factors[static_cast<std::size_t>(slot)].id = id;
+    const bool listed = residual_index.Insert(id, slot);
+    MSGRAPHS_ASSERT(listed, "s-graph residual index full or a block listed twice");
+  }
 
   std::vector<double> snapshot;  // parameter values before a solve, to undo a bad one
   // Jobs (s_graph_background.cpp) borrow the graph's cost functions: a full solve from its
@@ -221,6 +232,20 @@ struct SGraph::Impl {
   std::vector<double*> window_free;  // the window's free parameter blocks, sorted
   std::vector<std::pair<const double*, std::uint32_t>> window_free_planes;  // normal block, id
   std::vector<ceres::ResidualBlockId> window_residuals, scratch_residuals;
+  std::vector<std::pair<std::int32_t, ceres::ResidualBlockId>> scratch_slotted;
+  // Puts residual blocks in the order of their factor slots, not of their addresses or of
+  // Ceres' hash sets (s_graph_residual_index.hpp).
+  void SortBySlot(std::vector<ceres::ResidualBlockId>& ids) {
+    scratch_slotted.clear();
+    for (ceres::ResidualBlockId id : ids) {
+      const std::int32_t slot = residual_index.Find(id);
+      MSGRAPHS_ASSERT(slot != sgraph::ResidualIndex::kAbsent, "s-graph residual block without a factor");
+      scratch_slotted.emplace_back(slot, id);
+    }
+    std::sort(scratch_slotted.begin(), scratch_slotted.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = scratch_slotted[i].second;
+  }
   std::vector<double*> scratch_blocks;
   std::size_t window_residual_count = 0;  // residual blocks the last window problem held
   std::vector<std::unique_ptr<ceres::CostFunction>> window_costs;  // the held observations' sums
@@ -239,6 +264,9 @@ struct SGraph::Impl {
   // Which nodes move in a local solve: fills window_free; returns the free keyframes.
   std::size_t CollectWindow();
   void BuildWindowProblem();
+  // The whole graph as a problem of its own (in `window`), blocks and factors in slot order:
+  // what a full solve and the marginals on the spot hand Ceres.
+  void BuildFullProblem();
   // Snapshot (restore: put back) and finiteness of the window's free blocks only. The snapshot
   // buffer holds every block of the graph, so it holds the window's.
   void WindowSnapshot(bool restore);
@@ -308,6 +336,7 @@ struct SGraph::Impl {
     if (!f.active) return;
     f.active = false;
     --active_factors;
+    residual_index.Erase(f.id, slot);
     switch (f.kind) {
       case FactorKind::kRelative:
         --stats.relative_factors[static_cast<std::size_t>(f.relative)];
@@ -454,8 +483,8 @@ struct SGraph::Impl {
         kind == RelativePoseKind::kLoopClosure ? huber_loop.get() : huber_relative.get();
     FactorRecord& f = factors[static_cast<std::size_t>(*slot)];
     f.relative = kind;
-    f.id = problem->AddResidualBlock(cost, loss, keyframes[from].q, keyframes[from].t,
-                                     keyframes[to].q, keyframes[to].t);
+    Bind(*slot, problem->AddResidualBlock(cost, loss, keyframes[from].q, keyframes[from].t,
+                                          keyframes[to].q, keyframes[to].t));
     ++stats.relative_factors[static_cast<std::size_t>(kind)];
     if (kind == RelativePoseKind::kLoopClosure) {
       ++keyframes[from].loop_factors;

@@ -131,7 +131,10 @@ void SGraph::Impl::BuildWindowProblem() {
     if (std::any_of(scratch_blocks.begin(), scratch_blocks.end(), is_free))
       window_residuals.push_back(f.id);
   }
-  std::sort(window_residuals.begin(), window_residuals.end());
+  // By factor slot: Ceres orders its work (the fill-reducing ordering's ties, the sums) by the
+  // order it is handed blocks in, and an order by address would differ between two graphs
+  // with the same records.
+  SortBySlot(window_residuals);
   window_residuals.erase(std::unique(window_residuals.begin(), window_residuals.end()),
                          window_residuals.end());
   std::size_t kept = 0;
@@ -165,6 +168,45 @@ void SGraph::Impl::BuildWindowProblem() {
     ++kept;
   }
   window_residual_count = kept;  // what Ceres is handed
+}
+
+void SGraph::Impl::BuildFullProblem() {
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  window = std::make_unique<ceres::Problem>(options);
+  window_costs.clear();
+  const auto add_block = [this](double* block) {
+    window->AddParameterBlock(block, problem->ParameterBlockSize(block),
+                              const_cast<ceres::Manifold*>(problem->GetManifold(block)));
+    if (problem->IsParameterBlockConstant(block)) window->SetParameterBlockConstant(block);
+  };
+  // The graph's problem, in the order of the graph's own slots: its own order is the history
+  // of additions and removals (Ceres removes by swapping with the last), which a graph with
+  // the same records need not share.
+  for (std::size_t k = 0; k < keyframe_high_water; ++k) {
+    if (!keyframes[k].active) continue;
+    add_block(keyframes[k].q);
+    add_block(keyframes[k].t);
+  }
+  for (std::size_t i = 0; i < plane_count; ++i) {
+    if (!planes[i].in_problem) continue;
+    add_block(planes[i].n);
+    add_block(planes[i].d);
+  }
+  for (std::size_t i = 0; i < room_count; ++i)
+    if (rooms[i].in_problem) add_block(rooms[i].c);
+  if (problem->HasParameterBlock(floor_c)) add_block(floor_c);
+  for (std::size_t slot = 0; slot < factor_high_water; ++slot) {
+    const FactorRecord& f = factors[slot];
+    if (!f.active) continue;
+    problem->GetParameterBlocksForResidualBlock(f.id, &scratch_blocks);
+    window->AddResidualBlock(
+        const_cast<ceres::CostFunction*>(problem->GetCostFunctionForResidualBlock(f.id)),
+        const_cast<ceres::LossFunction*>(problem->GetLossFunctionForResidualBlock(f.id)),
+        scratch_blocks.data(), static_cast<int>(scratch_blocks.size()));
+  }
 }
 
 void SGraph::Impl::WindowSnapshot(bool restore) {
@@ -208,6 +250,8 @@ Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
   } else {
     report.free_keyframes = m.active_keyframes > 0 ? m.active_keyframes - 1 : 0;
     ++m.held_epoch;  // held keyframes move: every held sum is taken afresh
+    m.BuildFullProblem();
+    problem = m.window.get();
   }
   // Undo state: a local solve changes only its free blocks, so only those are kept (a full copy
   // would cost in proportion to the graph again).
@@ -246,6 +290,49 @@ Expected<SGraphSolveReport> SGraph::Solve(SolveKind kind) {
     ++m.stats.solves_undone;
   }
   return report;
+}
+
+Status SGraph::RebuildProblem() {
+  Impl& m = *impl_;
+  if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
+  if (m.OldestBorrower() != Impl::kNoBorrower || m.full_job_pending)
+    return Error{Errc::kWouldBlock, "a job borrows from this graph"};
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.enable_fast_removal = true;
+  auto rebuilt = std::make_unique<ceres::Problem>(options);
+  const auto add_block = [&](double* block) {
+    if (!m.problem->HasParameterBlock(block)) return;
+    rebuilt->AddParameterBlock(block, m.problem->ParameterBlockSize(block),
+                               const_cast<ceres::Manifold*>(m.problem->GetManifold(block)));
+    if (m.problem->IsParameterBlockConstant(block)) rebuilt->SetParameterBlockConstant(block);
+  };
+  if (m.problem->HasParameterBlock(m.floor_c)) add_block(m.floor_c);
+  for (std::size_t i = m.room_count; i-- > 0;) add_block(m.rooms[i].c);
+  for (std::size_t i = m.plane_count; i-- > 0;) {
+    add_block(m.planes[i].d);
+    add_block(m.planes[i].n);
+  }
+  for (std::size_t k = m.keyframe_high_water; k-- > 0;) {
+    add_block(m.keyframes[k].t);
+    add_block(m.keyframes[k].q);
+  }
+  m.residual_index.Clear();
+  for (std::size_t slot = m.factor_high_water; slot-- > 0;) {
+    FactorRecord& f = m.factors[slot];
+    if (!f.active) continue;
+    m.problem->GetParameterBlocksForResidualBlock(f.id, &m.scratch_blocks);
+    m.Bind(static_cast<std::int32_t>(slot),
+           rebuilt->AddResidualBlock(
+               const_cast<ceres::CostFunction*>(m.problem->GetCostFunctionForResidualBlock(f.id)),
+               const_cast<ceres::LossFunction*>(m.problem->GetLossFunctionForResidualBlock(f.id)),
+               m.scratch_blocks.data(), static_cast<int>(m.scratch_blocks.size())));
+  }
+  // The old problem owns none of the costs, losses or manifolds it shared.
+  m.problem = std::move(rebuilt);
+  return Ok();
 }
 
 }  // namespace msgraphs::core

@@ -33,25 +33,17 @@ Status SGraphSolveJob::Init(const SGraphConfig& config) {
   j.config = config;
   const std::size_t keyframes = config.max_keyframes + 1, planes = config.max_planes,
                     rooms = config.max_rooms;
-  for (Values* v : {&j.begin, &j.solved}) {
-    v->kq.assign(4 * keyframes, 0.0);
-    v->kt.assign(3 * keyframes, 0.0);
-    v->pn.assign(3 * planes, 0.0);
-    v->pd.assign(planes, 0.0);
-    v->rc.assign(2 * rooms, 0.0);
-  }
+  for (Values* v : {&j.begin, &j.solved}) v->Size(keyframes, planes, rooms);
   j.stamp.assign(keyframes, 0.0);
   j.keyframe_in.assign(keyframes, 0);
   j.plane_in.assign(planes, 0);
   j.room_in.assign(rooms, 0);
   // Every factor record is one residual block; a room's has the most parameter blocks (9).
   j.residuals.reserve(config.max_factors);
-  j.ids.reserve(config.max_factors);
   j.refs.reserve(config.max_factors * 4);
   j.marginal_ids.reserve(planes);
   j.marginal_blocks.reserve(planes);
   j.marginals.assign(planes, Eigen::Matrix3d::Zero());
-  j.left_out.reserve(config.max_factors);
   j.sized = true;
   return Ok();
 }

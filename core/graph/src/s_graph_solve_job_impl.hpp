@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 #include <ceres/sphere_manifold.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -23,17 +24,35 @@ namespace sgraph {
 enum JobState : int { kIdle, kReady, kRunning, kDone };
 enum class JobKind { kFullSolve, kMarginals };
 
-// Every estimate of a graph, flat, by slot.
+// Every estimate of a graph, flat, by slot, in one buffer: keyframe rotations, translations,
+// plane normals, offsets, room centres, the floor. One buffer, so that the blocks' addresses lie
+// in that order whatever the heap does: Ceres' covariance orders the blocks by address.
 struct Values {
-  std::vector<double> kq, kt, pn, pd, rc;
-  double floor[2] = {0, 0};
+  std::vector<double> all;
+  double *kq = nullptr, *kt = nullptr, *pn = nullptr, *pd = nullptr, *rc = nullptr,
+         *floor = nullptr;
 
+  Values() = default;
+  Values(const Values&) = delete;
+  // Both sized alike (Init): copies the values into the memory Init made.
+  Values& operator=(const Values& other) {
+    std::copy(other.all.begin(), other.all.end(), all.begin());
+    return *this;
+  }
+  void Size(std::size_t keyframes, std::size_t planes, std::size_t rooms) {
+    all.assign(7 * keyframes + 4 * planes + 2 * rooms + 2, 0.0);
+    kq = all.data();
+    kt = kq + 4 * keyframes;
+    pn = kt + 3 * keyframes;
+    pd = pn + 3 * planes;
+    rc = pd + planes;
+    floor = rc + 2 * rooms;
+  }
   Eigen::Isometry3d Pose(std::size_t k) const { return PoseOf(&kq[4 * k], &kt[3 * k]); }
   bool Finite() const {
-    for (const auto* v : {&kq, &kt, &pn, &pd, &rc})
-      for (double x : *v)
-        if (!std::isfinite(x)) return false;
-    return std::isfinite(floor[0]) && std::isfinite(floor[1]);
+    for (double x : all)
+      if (!std::isfinite(x)) return false;
+    return true;
   }
 };
 
@@ -64,10 +83,8 @@ struct SGraphSolveJob::Impl {
   std::int32_t origin = sgraph::kNone;
   std::vector<sgraph::JobResidual> residuals;
   std::vector<double*> refs;  // into `solved`
-  std::vector<ceres::ResidualBlockId> ids;
-  // The graph's plane-prior residual blocks a kOwn copy leaves out (sorted), and how many it
-  // left out: with any, Run solves the copy before its covariances.
-  std::vector<ceres::ResidualBlockId> left_out;
+  // How many plane priors a kOwn copy left out: with any, Run solves the copy before its
+  // covariances.
   std::size_t priors_left_out = 0;
   std::size_t priors_at_copy = 0;       // the graph's plane priors when it was copied
   std::uint64_t prior_adds_at_copy = 0;  // and its count of priors ever added

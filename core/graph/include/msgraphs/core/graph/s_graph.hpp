@@ -276,7 +276,17 @@ class SGraph {
   Status SetFloor(const Eigen::Vector2d& centre);
   Status AddFloorRoom(std::uint32_t room);
 
+  /// Solves the local window (the newest keyframes and what they see; allocates its window
+  /// problem) or the whole graph. Whatever order Ceres holds the graph's blocks in, every
+  /// problem handed to it lists nodes and factors by their slots (RebuildProblem).
   Expected<SGraphSolveReport> Solve(SolveKind kind);
+
+  /// Rebuilds the graph's Ceres problem from its own records, nodes and factors added newest
+  /// slot first, so that Ceres holds them in another order at other addresses. Nothing the
+  /// graph computes depends on that order, so it solves as before, bit for bit (tested); a
+  /// snapshot's load rebuilds the problem the same way. kWouldBlock while a job borrows from
+  /// the graph. Allocates.
+  Status RebuildProblem();
 
   // ---- the full solve in the background (s_graph_solve_job.hpp) ----
   /// Copies the graph as it is now into `job` (sized by its Init with this graph's config) for a
