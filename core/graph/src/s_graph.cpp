@@ -372,14 +372,12 @@ Status SGraph::UpdateRoom(std::uint32_t id, const MapRoom& updated) {
   };
   ceres::ResidualBlockId block = nullptr;
   if (updated.shape == RoomShape::kFourWall) {
-    auto* cost =
-        new ceres::AutoDiffCostFunction<sgraph::RoomResidual, 2, 2, 3, 1, 3, 1, 3, 1, 3, 1>(
-            new sgraph::RoomResidual{inv_sigma});
+    auto* cost = new sgraph::RoomCost(new sgraph::RoomResidual{inv_sigma});
     block = m.problem->AddResidualBlock(
         cost, m.huber_room.get(),
         {r.c, W(0).n, W(0).d, W(1).n, W(1).d, W(2).n, W(2).d, W(3).n, W(3).d});
   } else {
-    auto* cost = new ceres::AutoDiffCostFunction<sgraph::CorridorResidual, 2, 2, 3, 1, 3, 1>(
+    auto* cost = new sgraph::CorridorCost(
         new sgraph::CorridorResidual{updated.corridor_anchor, inv_sigma});
     block =
         m.problem->AddResidualBlock(cost, m.huber_room.get(), r.c, W(0).n, W(0).d, W(1).n, W(1).d);
@@ -423,7 +421,7 @@ Status SGraph::AddWallWall(std::uint32_t a, std::uint32_t b) {
   }
   auto slot = m.NewFactor(FactorKind::kWallWall, a, b);
   if (!slot) return slot.error();
-  auto* cost = new ceres::AutoDiffCostFunction<sgraph::WallWallResidual, 4, 3, 1, 3, 1>(
+  auto* cost = new sgraph::WallWallCost(
       new sgraph::WallWallResidual{1.0 / m.config.wall_wall_sigma});
   m.Bind(*slot, m.problem->AddResidualBlock(
       cost, m.huber_plane.get(), m.planes[a].n, m.planes[a].d, m.planes[b].n, m.planes[b].d));
@@ -465,7 +463,7 @@ Expected<std::uint32_t> SGraph::AddPlanePrior(const PlanePrior& prior) {
   if (!slot) return slot.error();
   Eigen::Vector3d u, v;
   WallBasis(prior.normal, u, v);
-  auto* cost = new ceres::AutoDiffCostFunction<sgraph::PlanePriorResidual, 3, 3, 1>(
+  auto* cost = new sgraph::PlanePriorCost(
       new sgraph::PlanePriorResidual{u, v, prior.d, Eigen::Matrix3d(info_llt.matrixU())});
   m.Bind(*slot, m.problem->AddResidualBlock(cost, m.huber_plane.get(), p.n, p.d));
   ++m.stats.plane_prior_factors;
@@ -503,7 +501,7 @@ Status SGraph::AddFloorRoom(std::uint32_t room) {
   auto slot = m.NewFactor(FactorKind::kFloorRoom, room, 0);
   if (!slot) return slot.error();
   const Eigen::Vector2d offset(m.floor_c[0] - r.c[0], m.floor_c[1] - r.c[1]);
-  auto* cost = new ceres::AutoDiffCostFunction<sgraph::FloorRoomResidual, 2, 2, 2>(
+  auto* cost = new sgraph::FloorRoomCost(
       new sgraph::FloorRoomResidual{offset, 1.0 / m.config.floor_room_sigma_m});
   m.Bind(*slot, m.problem->AddResidualBlock(cost, nullptr, m.floor_c, r.c));
   ++m.stats.floor_factors;

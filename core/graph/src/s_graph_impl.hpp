@@ -156,6 +156,12 @@ inline bool SolverFinished(const ceres::Solver::Summary& summary) {
 using RelativePoseCost = ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 4, 3, 4, 3>;
 // How every keyframe-to-plane factor is built: the local solve reads its measurement back.
 using PlaneCost = ceres::AutoDiffCostFunction<PlaneResidual, 3, 4, 3, 3, 1>;
+// The others, named so that a snapshot (s_graph_snapshot.cpp) reads each measurement back.
+using RoomCost = ceres::AutoDiffCostFunction<RoomResidual, 2, 2, 3, 1, 3, 1, 3, 1, 3, 1>;
+using CorridorCost = ceres::AutoDiffCostFunction<CorridorResidual, 2, 2, 3, 1, 3, 1>;
+using WallWallCost = ceres::AutoDiffCostFunction<WallWallResidual, 4, 3, 1, 3, 1>;
+using PlanePriorCost = ceres::AutoDiffCostFunction<PlanePriorResidual, 3, 3, 1>;
+using FloorRoomCost = ceres::AutoDiffCostFunction<FloorRoomResidual, 2, 2, 2>;
 
 }  // namespace sgraph
 

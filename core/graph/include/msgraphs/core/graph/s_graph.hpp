@@ -288,6 +288,21 @@ class SGraph {
   /// the graph. Allocates.
   Status RebuildProblem();
 
+  // ---- snapshots (s_graph_snapshot.cpp, docs/s-graph.md "Snapshots") ----
+  /// The most bytes Save can write for this graph's config.
+  std::size_t SnapshotBytes() const;
+  /// Writes the whole graph (every record in its slot, the free lists in their order, the held
+  /// sums, the counters, each factor's measurement) into `out`; returns the bytes written.
+  /// Loaded into a graph initialised with the same config, it goes on bit for bit as this one
+  /// would. kWouldBlock while a job borrows from the graph; kCapacityExceeded when `out` is too
+  /// small (SnapshotBytes always suffices). Allocates nothing.
+  Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
+  /// Replaces this graph by a snapshot. kInvalidArgument, with the graph unchanged, for bytes
+  /// that are not a whole snapshot of this version (CRC-32 checked) or that were made with
+  /// another config; a snapshot whose records do not hold together leaves the graph empty (as
+  /// Init left it). kWouldBlock while a job borrows from the graph. Allocates (Ceres' problem).
+  Status Load(std::span<const std::uint8_t> in);
+
   // ---- the full solve in the background (s_graph_solve_job.hpp) ----
   /// Copies the graph as it is now into `job` (sized by its Init with this graph's config) for a
   /// full solve elsewhere. kWouldBlock while another job is pending on this graph;
@@ -363,6 +378,7 @@ class SGraph {
 
  private:
   struct Impl;
+  struct SnapshotAccess;  // s_graph_snapshot.cpp
   // Copies every estimate and the residual blocks into a job (BeginFullSolve,
   // BeginPlaneMarginals), the plane priors' blocks left out with kOwn; the job then borrows the
   // graph's costs.
