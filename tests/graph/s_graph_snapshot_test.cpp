@@ -5,6 +5,8 @@
 // or writes past a store, whatever the bytes.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -114,36 +116,75 @@ TEST(SGraphSnapshot, BytesThatAreNotAWholeSnapshotOfThisConfigAreRefusedAndChang
   EXPECT_EQ(g.stats().keyframes, 120u);
 }
 
+// What a graph is asked to do after a load: every path that walks its links and counts.
+void Exercise(SGraph& g) {
+  std::uint32_t newest = 0;
+  bool have_newest = false;
+  for (std::uint32_t k = g.FirstKeyframe(); k != SGraph::kNoKeyframe; k = g.NextKeyframe(k)) {
+    newest = k;
+    have_newest = true;
+  }
+  for (int i = 0; i < 3; ++i) {  // past the store's capacity: sparsification
+    auto id = g.AddKeyframe(1e9 + i, Eigen::Isometry3d::Identity());
+    if (id && have_newest) {
+      static_cast<void>(g.AddRelativePose(newest, *id, Eigen::Isometry3d::Identity(),
+                                          OdometryInformation(), RelativePoseKind::kOdometry));
+    }
+    if (id) {
+      newest = *id;
+      have_newest = true;
+    }
+  }
+  static_cast<void>(g.Solve(SolveKind::kLocal));
+  static_cast<void>(g.Solve(SolveKind::kFull));
+  for (std::uint32_t r = 0; r < g.room_slots(); ++r) static_cast<void>(g.RemoveRoom(r));
+  std::vector<std::uint8_t> bytes(g.SnapshotBytes());
+  static_cast<void>(g.Save(bytes));
+}
+
 // Bytes that pass the CRC but were changed before it was taken (a writer's bug, or a file
-// crafted to pass): a load reads and writes within the stores whatever they hold (the sanitizer
-// builds run this), and a refused one leaves the graph empty (as it was, or as Init left it) and
-// usable. What a load that passes makes of such bytes is not judged: the CRC is the guard
-// against corruption, this only against a load that would crash.
-TEST(SGraphSnapshot, ALoadStaysWithinItsStoresWhateverTheBytesHold) {
+// made to pass): a load reads and writes within the stores whatever they hold, and so do the
+// graph's calls after it (the sanitizer builds run this). Half the changes are to bytes that
+// look like a count, an index, a flag or an enum (small values, or kNone's 0xFF), which the
+// structural checks must catch; a refused load leaves the graph empty (as it was, or as Init
+// left it) and usable. What a load that passes makes of such bytes is not judged beyond that:
+// the CRC is the guard against corruption.
+TEST(SGraphSnapshot, ALoadAndTheCallsAfterItStayWithinTheStoresWhateverTheBytesHold) {
   const std::vector<std::uint8_t> good = MissionSnapshot(150);
   ASSERT_GT(good.size(), 1000u);
   constexpr std::size_t kHeader = 24;
+  std::vector<std::size_t> small;  // positions of bytes that look structural
+  for (std::size_t i = kHeader; i < good.size(); ++i)
+    if (good[i] <= 8 || good[i] == 0xFF) small.push_back(i);
   std::mt19937 rng(17);
   std::uniform_int_distribution<std::size_t> at(kHeader, good.size() - 1);
+  std::uniform_int_distribution<std::size_t> at_small(0, small.size() - 1);
   std::uniform_int_distribution<int> byte(0, 255);
+  const std::array<std::uint8_t, 6> structural{0, 1, 2, 3, 7, 0xFF};
   std::size_t loaded = 0, refused = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    SGraph g;
-    ASSERT_TRUE(g.Init(MixedMissionConfig()));
+  for (int trial = 0; trial < 250; ++trial) {
     std::vector<std::uint8_t> bad = good;
-    const int changes = 1 + trial % 4;
-    for (int c = 0; c < changes; ++c) bad[at(rng)] = static_cast<std::uint8_t>(byte(rng));
+    const int changes = 1 + trial % 3;
+    for (int c = 0; c < changes; ++c) {
+      if (trial % 2 == 0) {
+        bad[at(rng)] = static_cast<std::uint8_t>(byte(rng));
+      } else {
+        bad[small[at_small(rng)]] = structural[static_cast<std::size_t>(byte(rng)) % structural.size()];
+      }
+    }
     const std::uint32_t crc = Crc32(std::span(bad).subspan(kHeader));
     std::memcpy(bad.data() + 20, &crc, 4);
+    SGraph g;
+    ASSERT_TRUE(g.Init(MixedMissionConfig()));
     if (g.Load(bad)) {
       ++loaded;
     } else {
       ++refused;
       EXPECT_EQ(g.stats().keyframes, 0u);
-      ASSERT_TRUE(g.AddKeyframe(0.0, Eigen::Isometry3d::Identity()));  // usable
     }
+    Exercise(g);
   }
-  // Most single changes land in an estimate (a valid graph); the rest are refused.
+  std::printf("changed snapshots: %zu loaded, %zu refused\n", loaded, refused);
   EXPECT_GT(loaded, 0u);
   EXPECT_GT(refused, 0u);
 }
@@ -162,11 +203,25 @@ TEST(SGraphSnapshot, NoSaveOrLoadWhileAJobBorrowsAndNoneIntoTooSmallABuffer) {
   auto busy = g.Save(bytes);
   ASSERT_FALSE(busy);
   EXPECT_EQ(busy.error().code, Errc::kWouldBlock);
+  const std::vector<std::uint8_t> other = MissionSnapshot(30);
+  const Status load_busy = g.Load(other);
+  ASSERT_FALSE(load_busy);
+  EXPECT_EQ(load_busy.error().code, Errc::kWouldBlock);
   job.Complete();
   ASSERT_TRUE(g.ApplyFullSolve(job));
   auto n = g.Save(bytes);
   ASSERT_TRUE(n);
   EXPECT_LE(*n, g.SnapshotBytes());
+  // A graph just loaded saves without allocating too.
+  SGraph loaded;
+  ASSERT_TRUE(loaded.Init(MixedMissionConfig()));
+  ASSERT_TRUE(loaded.Load(other));
+  std::vector<std::uint8_t> again(loaded.SnapshotBytes());
+  test::AllocationScope scope;
+  auto m = loaded.Save(again);
+  EXPECT_EQ(scope.allocations(), 0u);
+  ASSERT_TRUE(m);
+  EXPECT_EQ(*m, other.size());
 }
 
 }  // namespace

@@ -6,12 +6,14 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/graph/distilled_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "s_graph_covariance.hpp"
 #include "s_graph_factors.hpp"
 #include "s_graph_impl.hpp"
@@ -81,6 +83,8 @@ Status SGraph::Init(const SGraphConfig& config) {
   m.free_factor_slots.reserve(config.max_factors);
   m.factor_high_water = m.active_factors = 0;
   m.residual_index.Init(config.max_factors);
+  m.marginals_now.reset();  // sized for the old config
+  m.scratch_blocks.reserve(16);  // a factor's blocks (a room's: 9): Save allocates nothing
   m.retired_costs.reserve(config.max_factors);
   m.plane_only_factors.clear();
   m.plane_only_factors.reserve(config.max_factors);
@@ -538,27 +542,27 @@ MapPlane SGraph::plane(std::uint32_t id) const {
 Status SGraph::PlaneMarginals(std::span<const std::uint32_t> ids,
                               std::span<Eigen::Matrix3d> covariances) const {
   Impl& m = *impl_;
+  if (covariances.size() < ids.size())
+    return Error{Errc::kCapacityExceeded, "plane marginals: output shorter than the plane list"};
   // Ceres recovers the marginals from one factorisation of the whole problem; it allocates,
   // which is why this runs at the distillation cadence, not per keyframe (and the distiller
-  // runs it in the background: BeginPlaneMarginals).
-  std::vector<sgraph::PlaneBlocks> planes;
-  planes.reserve(ids.size());
-  for (std::uint32_t id : ids) {
-    if (id >= m.plane_count || !m.planes[id].in_problem)
-      return Error{Errc::kNotFound, "plane marginals: plane not in the optimisation"};
-    const PlaneNode& p = m.planes[id];
-    // Nothing measures it any more (its observers were sparsified away): Ceres would give it
-    // a zero covariance, certainty it never had.
-    if (p.info.live_observations == 0)
-      return Error{Errc::kInvalidArgument, "plane marginals: the plane has no observation left"};
-    planes.push_back({p.n, p.d, p.info.basis_u, p.info.basis_v});
+  // runs it in the background: BeginPlaneMarginals). It runs the same job here, on the spot:
+  // the job holds its estimates in one buffer in slot order, and Ceres' covariance orders
+  // blocks by address, so the result never depends on where the heap put the graph's stores.
+  if (!m.marginals_now) {
+    auto job = std::make_unique<SGraphSolveJob>();  // once per Init
+    if (auto s = job->Init(m.config); !s) return s;
+    m.marginals_now = std::move(job);
   }
-  // Every block but the origin's is variable (local solves move a window problem of their
-  // own), so the covariance is over the whole graph, handed to Ceres in slot order.
-  m.BuildFullProblem();
-  const Status s = sgraph::PlaneCovariances(*m.window, planes, covariances);
-  m.window.reset();
-  return s;
+  SGraphSolveJob& job = *m.marginals_now;
+  if (auto s = BeginPlaneMarginals(job, ids, PlaneEvidence::kAll); !s) return s;
+  job.Complete();
+  const std::span<const Eigen::Matrix3d> result = job.plane_marginals();
+  const bool ok = result.size() == ids.size();
+  if (ok) std::copy(result.begin(), result.end(), covariances.begin());
+  static_cast<void>(job.Release());
+  if (!ok) return Error{Errc::kDegenerate, "plane marginals: the problem is rank deficient"};
+  return Ok();
 }
 
 std::size_t SGraph::room_slots() const { return impl_->room_count; }

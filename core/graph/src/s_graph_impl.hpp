@@ -20,6 +20,7 @@
 #include "msgraphs/base/assert.hpp"
 #include "msgraphs/core/geometry/se3.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
+#include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "s_graph_factors.hpp"
 #include "s_graph_residual_index.hpp"
 
@@ -225,6 +226,8 @@ struct SGraph::Impl {
   };
   std::vector<RetiredCost> retired_costs;
   std::vector<const ceres::CostFunction*> scratch_costs;
+  // The job PlaneMarginals runs on the spot (made at its first call after Init).
+  std::unique_ptr<SGraphSolveJob> marginals_now;
   bool full_job_pending = false;  // one full solve at a time (ApplyFullSolve carries from it)
   // Plane priors were added since the last converged full solve without any: the estimates may
   // still hold their pull (estimates_hold_priors).

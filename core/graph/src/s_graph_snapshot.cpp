@@ -13,7 +13,10 @@
 // Each record is written and read by one visitor (Io), so the two sides cannot disagree.
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <array>
+#include <limits>
+#include <vector>
 #include <cstring>
 
 #include "msgraphs/base/crc32.hpp"
@@ -48,25 +51,6 @@ enum class CostOf : std::uint8_t {
   kPlanePrior
 };
 constexpr std::uint8_t kCostKinds = 7;
-
-// A bool as one byte, 0 or 1 (read: anything else is 1).
-template <class Ar>
-void IoBool(Ar& ar, bool& b) {
-  std::uint8_t v = b ? 1 : 0;
-  ar(v);
-  if constexpr (Ar::kLoading) b = v != 0;
-}
-
-// An enum as its underlying byte; a value at or past `count` fails the reader.
-template <class Ar, typename E>
-void IoEnum(Ar& ar, E& e, std::uint8_t count) {
-  auto v = static_cast<std::uint8_t>(e);
-  ar(v);
-  if constexpr (Ar::kLoading) {
-    if (v >= count) ar.Fail();
-    e = static_cast<E>(v);
-  }
-}
 
 template <class Ar>
 void Io(Ar& ar, SGraphConfig& c) {
@@ -194,16 +178,10 @@ void Io(Ar& ar, sgraph::FloorRoomResidual& z) {
 
 // A free list or index list: its length, then its entries (Init reserved the capacity).
 template <class Ar>
-void IoList(Ar& ar, std::vector<std::int32_t>& list) {
-  std::uint64_t n = list.size();
-  ar(n);
-  if constexpr (Ar::kLoading) {
-    if (n > list.capacity()) {
-      ar.Fail();
-      return;
-    }
-    list.resize(static_cast<std::size_t>(n));
-  }
+void IoList(Ar& ar, std::vector<std::int32_t>& list, std::size_t max) {
+  std::size_t n = list.size();
+  IoCount(ar, n, std::min(max, list.capacity()));
+  if constexpr (Ar::kLoading) list.resize(n);  // within the capacity Init reserved
   ar(list.data(), list.size());
 }
 
@@ -233,7 +211,12 @@ struct SGraph::SnapshotAccess {
     ar(m.held_epoch);
     IoBool(ar, m.prior_pull);
     ar(m.prior_adds);
-    ar(m.stats);
+    // The revision is this process's count of changes, not the graph's: not saved (Load moves
+    // it past the loading graph's own).
+    SGraphStats stats = m.stats;
+    stats.revision = 0;
+    ar(stats);
+    if constexpr (Ar::kLoading) m.stats = stats;
   }
 
   static bool Name(const SGraph::Impl& m, const double* block, BlockRef& ref) {
@@ -369,6 +352,67 @@ struct SGraph::SnapshotAccess {
     return new Cost(new Residual(z));
   }
 
+  // What a factor record of its kind must hold: its cost, its loss and the blocks of the nodes
+  // it names (a removal finds a factor by its record, and Ceres removes what is on the blocks:
+  // the two must agree). False for a record naming nodes beyond the stores.
+  static bool Expect(const SGraph::Impl& m, const FactorRecord& f, CostOf cost, LossOf loss,
+                     std::array<BlockRef, kMaxBlocks>& want, std::size_t& n) {
+    const auto kf = [&](std::uint32_t k) { return k < m.keyframe_high_water; };
+    const auto pl = [&](std::uint32_t p) { return p < m.plane_count; };
+    const auto add = [&](BlockOf of, std::uint32_t index) { want[n++] = {of, index}; };
+    const auto keyframe = [&](std::uint32_t k) {
+      add(BlockOf::kKeyframeQ, k);
+      add(BlockOf::kKeyframeT, k);
+    };
+    const auto plane = [&](std::uint32_t p) {
+      add(BlockOf::kPlaneN, p);
+      add(BlockOf::kPlaneD, p);
+    };
+    n = 0;
+    switch (f.kind) {
+      case FactorKind::kRelative:
+        if (!kf(f.a) || !kf(f.b) || cost != CostOf::kRelative ||
+            loss != (f.relative == RelativePoseKind::kLoopClosure ? LossOf::kLoop : LossOf::kRelative))
+          return false;
+        keyframe(f.a);
+        keyframe(f.b);
+        return true;
+      case FactorKind::kPlane:
+        if (!kf(f.a) || !pl(f.b) || cost != CostOf::kPlane || loss != LossOf::kPlane) return false;
+        keyframe(f.a);
+        plane(f.b);
+        return true;
+      case FactorKind::kRoom: {
+        if (f.a >= m.room_count || loss != LossOf::kRoom) return false;
+        const MapRoom& room = m.rooms[f.a].info;
+        const bool four = room.shape == RoomShape::kFourWall;
+        if (cost != (four ? CostOf::kRoom : CostOf::kCorridor)) return false;
+        add(BlockOf::kRoom, f.a);
+        for (int w = 0; w < (four ? 4 : 2); ++w) {
+          const std::int32_t wall = room.walls[static_cast<std::size_t>(w)];
+          if (wall < 0 || !pl(static_cast<std::uint32_t>(wall))) return false;
+          plane(static_cast<std::uint32_t>(wall));
+        }
+        return true;
+      }
+      case FactorKind::kWallWall:
+        if (!pl(f.a) || !pl(f.b) || cost != CostOf::kWallWall || loss != LossOf::kPlane) return false;
+        plane(f.a);
+        plane(f.b);
+        return true;
+      case FactorKind::kFloorRoom:
+        if (f.a >= m.room_count || cost != CostOf::kFloorRoom || loss != LossOf::kNone) return false;
+        add(BlockOf::kFloor, 0);
+        add(BlockOf::kRoom, f.a);
+        return true;
+      case FactorKind::kPlanePrior:
+        if (!pl(f.a) || cost != CostOf::kPlanePrior || loss != LossOf::kPlane) return false;
+        plane(f.a);
+        return true;
+    }
+    return false;
+  }
+
   // One factor's residual block, read and added to the loaded graph's problem.
   static bool LoadFactor(SnapshotReader& r, SGraph::Impl& m, std::int32_t slot) {
     CostOf cost_of{};
@@ -378,13 +422,18 @@ struct SGraph::SnapshotAccess {
     IoEnum(r, loss_of, 5);
     r(count);
     if (r.failed() || count > kMaxBlocks) return false;
+    std::array<BlockRef, kMaxBlocks> want{};
+    std::size_t want_count = 0;
+    if (!Expect(m, m.factors[static_cast<std::size_t>(slot)], cost_of, loss_of, want, want_count) ||
+        want_count != count)
+      return false;
     std::array<double*, kMaxBlocks> blocks{};
     std::array<int, kMaxBlocks> sizes{};
     for (std::size_t i = 0; i < count; ++i) {
       BlockRef ref;
       IoEnum(r, ref.of, 6);
       r(ref.index);
-      if (r.failed()) return false;
+      if (r.failed() || ref.of != want[i].of || ref.index != want[i].index) return false;
       blocks[i] = Resolve(m, ref, sizes[i]);
       if (blocks[i] == nullptr) return false;
     }
@@ -416,50 +465,123 @@ struct SGraph::SnapshotAccess {
     return true;
   }
 
-  // Every index a record holds lies within the stores (the CRC guards against corruption, this
-  // against a snapshot that is well formed but inconsistent: never a write past a store).
+  // The records hold together as the graph's own calls leave them (the CRC guards against
+  // corruption, this against a snapshot written wrongly or made to pass it): every later call
+  // walks these links and counts, so none may point past a store, loop, or disagree with what
+  // Ceres holds. Counts are recomputed and compared, not trusted.
   static bool Consistent(const SGraph::Impl& m) {
-    const auto keyframe = [&](std::int64_t k) {
-      return k == kNone || (k >= 0 && static_cast<std::size_t>(k) < m.keyframe_high_water);
-    };
-    if (m.keyframe_high_water > m.keyframes.size() || m.plane_count > m.planes.size() ||
-        m.room_count > m.rooms.size() || m.factor_high_water > m.factors.size() ||
-        !keyframe(m.newest) || !keyframe(m.origin))
+    const std::size_t kfs = m.keyframe_high_water, factors = m.factor_high_water;
+    if (kfs > m.keyframes.size() || m.plane_count > m.planes.size() ||
+        m.room_count > m.rooms.size() || factors > m.factors.size())
       return false;
-    for (std::size_t k = 0; k < m.keyframe_high_water; ++k)
-      if (!keyframe(m.keyframes[k].prev) || !keyframe(m.keyframes[k].next)) return false;
-    for (std::int32_t s : m.free_keyframe_slots)
-      if (s < 0 || static_cast<std::size_t>(s) >= m.keyframe_high_water) return false;
-    const auto factor = [&](std::int32_t f) {
-      return f == kNone || (f >= 0 && static_cast<std::size_t>(f) < m.factor_high_water);
+    // The time chain: from the origin by `next` to the newest, every node active, links
+    // mutual, stamps rising, and no active keyframe off it.
+    std::size_t active = 0;
+    for (std::size_t k = 0; k < kfs; ++k) if (m.keyframes[k].active) ++active;
+    if (active != m.active_keyframes) return false;
+    if (active == 0) {
+      if (m.origin != kNone || m.newest != kNone) return false;
+    } else {
+      const auto in = [&](std::int32_t k) { return k >= 0 && static_cast<std::size_t>(k) < kfs; };
+      if (!in(m.origin) || !in(m.newest)) return false;
+      std::size_t walked = 0;
+      std::int32_t prev = kNone;
+      double stamp = -std::numeric_limits<double>::infinity();
+      for (std::int32_t k = m.origin; k != kNone; k = m.keyframes[static_cast<std::size_t>(k)].next) {
+        if (!in(k) || ++walked > active) return false;
+        const KeyframeNode& node = m.keyframes[static_cast<std::size_t>(k)];
+        if (!node.active || node.prev != prev || !(node.stamp_s > stamp)) return false;
+        prev = k;
+        stamp = node.stamp_s;
+      }
+      if (walked != active || prev != m.newest) return false;
+    }
+    // Free slots: each once, none in use, and with those in use they make up every slot.
+    const auto free_list_ok = [](const std::vector<std::int32_t>& list, std::size_t high_water,
+                                 std::size_t in_use, const auto& used) {
+      if (list.size() + in_use != high_water) return false;
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::int32_t s = list[i];
+        if (s < 0 || static_cast<std::size_t>(s) >= high_water || used(static_cast<std::size_t>(s)))
+          return false;
+        for (std::size_t j = 0; j < i; ++j)
+          if (list[j] == s) return false;
+      }
+      return true;
     };
-    for (std::int32_t s : m.free_factor_slots)
-      if (s < 0 || !factor(s)) return false;
+    if (!free_list_ok(m.free_keyframe_slots, kfs, active,
+                      [&](std::size_t s) { return m.keyframes[s].active; }))
+      return false;
+    std::size_t live = 0;
+    for (std::size_t s = 0; s < factors; ++s) if (m.factors[s].active) ++live;
+    if (live != m.active_factors ||
+        !free_list_ok(m.free_factor_slots, factors, live,
+                      [&](std::size_t s) { return m.factors[s].active; }))
+      return false;
     for (std::int32_t s : m.plane_only_factors)
-      if (s < 0 || !factor(s)) return false;
+      if (s < 0 || static_cast<std::size_t>(s) >= factors) return false;
+    // Rooms: walls of their shape, and their factors pointing back at them.
+    const auto room_factor = [&](std::int32_t f, FactorKind kind, std::size_t room) {
+      if (f == kNone) return true;
+      if (f < 0 || static_cast<std::size_t>(f) >= factors) return false;
+      const FactorRecord& rec = m.factors[static_cast<std::size_t>(f)];
+      return rec.active && rec.kind == kind && rec.a == room;
+    };
     for (std::size_t i = 0; i < m.room_count; ++i) {
       const RoomNode& r = m.rooms[i];
-      if (!factor(r.factor) || !factor(r.floor_factor)) return false;
-      for (std::int32_t w : r.info.walls)
-        if (w < -1 || w >= static_cast<std::int64_t>(m.plane_count)) return false;
-    }
-    for (std::size_t s = 0; s < m.factor_high_water; ++s) {
-      const FactorRecord& f = m.factors[s];
-      const bool kf_a = f.a < m.keyframe_high_water, kf_b = f.b < m.keyframe_high_water;
-      const bool plane_a = f.a < m.plane_count, plane_b = f.b < m.plane_count;
-      const bool room_a = f.a < m.room_count;
-      bool ok = true;
-      switch (f.kind) {
-        case FactorKind::kRelative: ok = kf_a && kf_b; break;
-        case FactorKind::kPlane: ok = kf_a && plane_b; break;
-        case FactorKind::kRoom: ok = room_a; break;
-        case FactorKind::kWallWall: ok = plane_a && plane_b; break;
-        case FactorKind::kFloorRoom: ok = room_a; break;
-        case FactorKind::kPlanePrior: ok = plane_a; break;
+      if (!room_factor(r.factor, FactorKind::kRoom, i) ||
+          !room_factor(r.floor_factor, FactorKind::kFloorRoom, i))
+        return false;
+      if (!r.in_problem) continue;
+      const int walls = r.info.shape == RoomShape::kFourWall ? 4 : 2;
+      for (int w = 0; w < walls; ++w) {
+        const std::int32_t p = r.info.walls[static_cast<std::size_t>(w)];
+        if (p < 0 || static_cast<std::size_t>(p) >= m.plane_count ||
+            !m.planes[static_cast<std::size_t>(p)].in_problem)
+          return false;
       }
-      if (f.active && !ok) return false;
     }
-    return true;
+    // Every count a removal decrements, recomputed from the factors.
+    std::array<std::size_t, 4> relative{};
+    std::size_t plane_factors = 0, room_factors = 0, wall_wall = 0, floor_factors = 0, priors = 0;
+    std::vector<std::uint32_t> loops(kfs, 0), observations(m.plane_count, 0);
+    for (std::size_t s = 0; s < factors; ++s) {
+      const FactorRecord& f = m.factors[s];
+      if (!f.active) continue;
+      switch (f.kind) {
+        case FactorKind::kRelative:
+          ++relative[static_cast<std::size_t>(f.relative)];
+          if (f.relative == RelativePoseKind::kLoopClosure) {
+            ++loops[f.a];
+            ++loops[f.b];
+          }
+          if (!m.keyframes[f.a].active || !m.keyframes[f.b].active) return false;
+          break;
+        case FactorKind::kPlane:
+          ++plane_factors;
+          ++observations[f.b];
+          if (!m.keyframes[f.a].active) return false;
+          break;
+        case FactorKind::kRoom:
+          ++room_factors;
+          if (m.rooms[f.a].factor != static_cast<std::int32_t>(s)) return false;
+          break;
+        case FactorKind::kWallWall: ++wall_wall; break;
+        case FactorKind::kFloorRoom:
+          ++floor_factors;
+          if (m.rooms[f.a].floor_factor != static_cast<std::int32_t>(s) || !m.floor_active) return false;
+          break;
+        case FactorKind::kPlanePrior: ++priors; break;
+      }
+    }
+    for (std::size_t k = 0; k < kfs; ++k)
+      if (m.keyframes[k].active && m.keyframes[k].loop_factors != loops[k]) return false;
+    for (std::size_t p = 0; p < m.plane_count; ++p)
+      if (m.planes[p].info.live_observations != observations[p]) return false;
+    const SGraphStats& st = m.stats;
+    return st.relative_factors == relative && st.plane_factors == plane_factors &&
+           st.room_factors == room_factors && st.wall_wall_factors == wall_wall &&
+           st.floor_factors == floor_factors && st.plane_prior_factors == priors;
   }
 };
 
@@ -493,9 +615,9 @@ Expected<std::size_t> SGraph::Save(std::span<std::uint8_t> out) const {
     if (m.factors[s].active && !SnapshotAccess::SaveFactor(w, m, m.factors[s]))
       return Error{Errc::kInvalidArgument, "s-graph snapshot: a factor the snapshot cannot name"};
   }
-  IoList(w, m.free_keyframe_slots);
-  IoList(w, m.free_factor_slots);
-  IoList(w, m.plane_only_factors);
+  IoList(w, m.free_keyframe_slots, m.keyframes.size());
+  IoList(w, m.free_factor_slots, m.factors.size());
+  IoList(w, m.plane_only_factors, m.factors.size());
   if (w.failed()) return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
   const std::span<const std::uint8_t> payload = out.subspan(kHeaderBytes, w.size());
   SnapshotWriter h(out.first(kHeaderBytes));
@@ -539,11 +661,14 @@ Status SGraph::Load(std::span<const std::uint8_t> in) {
   Io(wb, now);
   if (r.failed() || wa.size() != wb.size() || std::memcmp(a.data(), b.data(), wa.size()) != 0)
     return Error{Errc::kInvalidArgument, "s-graph snapshot: made with another graph config"};
-  // From here the graph is replaced: any failure leaves it empty (as Init left it).
+  // From here the graph is replaced: any failure leaves it empty (as Init left it). Either
+  // way its revision goes past every one it had: it is not the graph a reader saw before.
   const SGraphConfig config = m.config;
+  const std::uint64_t revision_before = m.stats.revision;
   if (auto s = Init(config); !s) return s;
   const auto fail = [&](const char* why) -> Status {
     static_cast<void>(Init(config));
+    m.stats.revision = revision_before + 1;
     return Error{Errc::kInvalidArgument, why};
   };
   const SGraphStats init_stats = m.stats;
@@ -581,13 +706,14 @@ Status SGraph::Load(std::span<const std::uint8_t> in) {
     if (m.factors[s].active && !SnapshotAccess::LoadFactor(r, m, static_cast<std::int32_t>(s)))
       return fail("s-graph snapshot: a factor names no node of the graph");
   }
-  IoList(r, m.free_keyframe_slots);
-  IoList(r, m.free_factor_slots);
-  IoList(r, m.plane_only_factors);
+  IoList(r, m.free_keyframe_slots, m.keyframes.size());
+  IoList(r, m.free_factor_slots, m.factors.size());
+  IoList(r, m.plane_only_factors, m.factors.size());
   if (r.failed() || r.remaining() != 0) return fail("s-graph snapshot: lists truncated or overlong");
-  if (!SnapshotAccess::Consistent(m)) return fail("s-graph snapshot: records out of range");
+  if (!SnapshotAccess::Consistent(m)) return fail("s-graph snapshot: records that do not hold together");
   if (m.residual_index.size() != m.active_factors)
     return fail("s-graph snapshot: factor count differs from its records");
+  m.stats.revision = std::max(m.stats.revision, revision_before) + 1;
   return Ok();
 }
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/perception/free_space_grid.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -211,5 +212,24 @@ void FreeSpaceGrid::Integrate(const Eigen::Vector3f& sensor, std::span<const Eig
     }
   }
 }
+
+
+template <class Archive>
+void FreeSpaceGrid::Io(Archive& ar) {
+  IoSameSize(ar, free_.size());
+  if (ar.failed()) return;
+  ar(free_.data(), free_.size());
+  ar(occupied_.data(), occupied_.size());
+  ar(clear_low_.data(), clear_low_.size());
+  ar(low_directions_.data(), low_directions_.size());
+  ar(outside_);
+  ar(moves_);
+  ar(config_.origin_m.data(), 2);
+  ar(origin0_m_.data(), 2);
+  ar(moved_cells_.data(), 2);
+}
+
+void FreeSpaceGrid::Save(SnapshotWriter& w) const { const_cast<FreeSpaceGrid*>(this)->Io(w); }
+void FreeSpaceGrid::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

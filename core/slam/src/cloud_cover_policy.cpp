@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/cloud_cover_policy.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -95,5 +96,21 @@ bool CloudCoverPolicy::Coarsen() {
   ++coarsenings_;
   return true;
 }
+
+
+// Only the cell size persists; the cells and the pinned keyframes are taken afresh each pass,
+// and what the policy judges against is bound again before each Put.
+template <class Archive>
+void CloudCoverPolicy::Io(Archive& ar) {
+  ar(cell_m_);
+  ar(max_cell_m_);
+  ar(coarsenings_);
+  if constexpr (Archive::kLoading) {
+    if (!(cell_m_ > 0) || !(max_cell_m_ >= cell_m_)) ar.Fail();
+  }
+}
+
+void CloudCoverPolicy::Save(SnapshotWriter& w) const { const_cast<CloudCoverPolicy*>(this)->Io(w); }
+void CloudCoverPolicy::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

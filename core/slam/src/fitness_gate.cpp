@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/fitness_gate.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -61,5 +62,19 @@ double FitnessGate::Limit() {
   const double bound = median + config_.outlier_z * 1.4826 * mad;
   return std::max(config_.floor_m2, bound);
 }
+
+
+template <class Archive>
+void FitnessGate::Io(Archive& ar) {
+  IoSameSize(ar, ring_.size());
+  if (ar.failed() || ring_.empty()) return;
+  ar(ring_.data(), ring_.size());
+  IoCount(ar, next_, ring_.size() - 1);
+  IoCount(ar, count_, ring_.size());
+  ar(ignored_);
+}
+
+void FitnessGate::Save(SnapshotWriter& w) const { const_cast<FitnessGate*>(this)->Io(w); }
+void FitnessGate::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/keyframe_cloud_store.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <algorithm>
 
@@ -142,5 +143,53 @@ std::span<const Eigen::Vector3f> KeyframeCloudStore::Get(std::uint32_t key,
   if (!e.valid || e.sequence != sequence) return {};
   return std::span<const Eigen::Vector3f>(points_.data() + e.offset, e.count);
 }
+
+
+template <class Archive>
+void KeyframeCloudStore::Io(Archive& ar) {
+  IoSameSize(ar, points_.size());
+  IoSameSize(ar, entries_.size());
+  if (ar.failed()) return;
+  // The points in use only: below top_, the live clouds and the gaps compaction has not closed.
+  IoCount(ar, top_, points_.size());
+  for (std::size_t i = 0; i < top_; ++i) ar(points_[i].data(), 3);
+  for (Entry& e : entries_) {
+    ar(e.offset);
+    ar(e.count);
+    ar(e.sequence);
+    ar(e.stamp);
+    IoBool(ar, e.valid);
+    if constexpr (Archive::kLoading) {
+      if (e.valid && (e.offset > top_ || e.count > top_ - e.offset)) ar.Fail();
+    }
+  }
+  IoCount(ar, order_size_, order_.size());
+  for (std::size_t i = 0; i < order_size_; ++i) {
+    ar(order_[i]);
+    ar(order_stamp_[i]);
+    if constexpr (Archive::kLoading) {
+      if (order_[i] >= entries_.size()) ar.Fail();
+    }
+  }
+  ar(stamp_);
+  IoCount(ar, used_, points_.size());
+  IoCount(ar, peak_, points_.size());
+  IoCount(ar, live_, entries_.size());
+  IoCount(ar, reclaim_, points_.size());
+  ar(stats_);
+  if constexpr (Archive::kLoading) {
+    // The counts eviction works from, recomputed: what the entries say is in the store.
+    std::size_t used = 0, live = 0;
+    for (const Entry& e : entries_) {
+      if (!e.valid) continue;
+      used += e.count;
+      ++live;
+    }
+    if (used != used_ || live != live_ || peak_ < used_) ar.Fail();
+  }
+}
+
+void KeyframeCloudStore::Save(SnapshotWriter& w) const { const_cast<KeyframeCloudStore*>(this)->Io(w); }
+void KeyframeCloudStore::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/loop_closer.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -179,5 +180,28 @@ bool LoopCloser::RejectIfContradicted(SGraph& graph,
   --stats_.accepted;
   return true;
 }
+
+
+// The keyframes' descriptors and where they were on the path; the target and candidate buffers
+// are filled afresh by each detection.
+template <class Archive>
+void LoopCloser::Io(Archive& ar) {
+  IoSameSize(ar, entries_.size());
+  IoSameSize(ar, cells_.size());
+  if (ar.failed()) return;
+  // A descriptor only where its keyframe is listed (the search reads no other).
+  for (std::size_t k = 0; k < entries_.size(); ++k) {
+    Entry& e = entries_[k];
+    ar(e.sequence);
+    ar(e.path_m);
+    IoBool(ar, e.valid);
+    if (e.valid) ar(cells_.data() + k * cells_per_keyframe_, cells_per_keyframe_);
+  }
+  ar(last_loop_path_m_);
+  ar(stats_);
+}
+
+void LoopCloser::Save(SnapshotWriter& w) const { const_cast<LoopCloser*>(this)->Io(w); }
+void LoopCloser::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/odometry_buffer.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <cmath>
 
@@ -66,5 +67,21 @@ Expected<OdometryLookup> OdometryBuffer::At(double stamp_s) const {
       Interpolate(poses_[Index(lo - 1)], poses_[Index(lo)], (stamp_s - t0) / (t1 - t0));
   return out;
 }
+
+
+template <class Archive>
+void OdometryBuffer::Io(Archive& ar) {
+  IoSameSize(ar, stamps_.size());
+  if (ar.failed()) return;
+  ar(stamps_.data(), stamps_.size());
+  for (Eigen::Isometry3d& T : poses_) ar(T.matrix().data(), 16);
+  IoCount(ar, head_, stamps_.size() - 1);
+  IoCount(ar, size_, stamps_.size());
+  ar(max_gap_s_);
+  ar(stats_);
+}
+
+void OdometryBuffer::Save(SnapshotWriter& w) const { const_cast<OdometryBuffer*>(this)->Io(w); }
+void OdometryBuffer::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/plane_mapper.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -191,5 +192,23 @@ void PlaneMapper::MapWalls(const SGraph& graph,
     ids.push_back(id);
   }
 }
+
+
+template <class Archive>
+void PlaneMapper::Io(Archive& ar) {
+  IoSameSize(ar, extents_.size());
+  if (ar.failed()) return;
+  for (WallExtent& e : extents_) {
+    ar(e.a.data(), 2);
+    ar(e.b.data(), 2);
+    ar(e.z_min);
+    ar(e.z_max);
+    IoBool(ar, e.valid);
+  }
+  ar(stats_);
+}
+
+void PlaneMapper::Save(SnapshotWriter& w) const { const_cast<PlaneMapper*>(this)->Io(w); }
+void PlaneMapper::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "msgraphs/core/slam/room_mapper.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -134,5 +135,28 @@ Status RoomMapper::Update(const FreeSpaceGrid& grid, const PlaneMapper& planes, 
   }
   return Ok();
 }
+
+
+// The wall pairs already tied; regions, detected rooms and walls are taken afresh each update.
+template <class Archive>
+void RoomMapper::Io(Archive& ar) {
+  std::size_t pairs = wall_pairs_.size();
+  IoCount(ar, pairs, wall_pairs_.capacity());
+  if (ar.failed()) return;
+  if constexpr (Archive::kLoading) {
+    wall_pairs_.clear();
+    for (std::size_t i = 0; i < pairs; ++i) {
+      std::uint64_t k = 0;
+      ar(k);
+      wall_pairs_.push_back(k);
+    }
+  } else {
+    for (std::uint64_t k : wall_pairs_) ar(k);
+  }
+  ar(stats_);
+}
+
+void RoomMapper::Save(SnapshotWriter& w) const { const_cast<RoomMapper*>(this)->Io(w); }
+void RoomMapper::Load(SnapshotReader& r) { Io(r); }
 
 }  // namespace msgraphs::core

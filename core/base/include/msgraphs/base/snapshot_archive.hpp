@@ -90,4 +90,44 @@ class SnapshotReader {
   bool failed_ = false;
 };
 
+// A bool as one byte, 0 or 1 (read: anything else is 1).
+template <class Archive>
+void IoBool(Archive& ar, bool& b) {
+  std::uint8_t v = b ? 1 : 0;
+  ar(v);
+  if constexpr (Archive::kLoading) b = v != 0;
+}
+
+// An enum as its underlying byte; a value at or past `count` fails the reader.
+template <class Archive, typename E>
+void IoEnum(Archive& ar, E& e, std::uint8_t count) {
+  auto v = static_cast<std::uint8_t>(e);
+  ar(v);
+  if constexpr (Archive::kLoading) {
+    if (v >= count) ar.Fail();
+    e = static_cast<E>(v);
+  }
+}
+
+// A count of entries; above `max` fails the reader (and reads as 0).
+template <class Archive>
+void IoCount(Archive& ar, std::size_t& n, std::size_t max) {
+  auto v = static_cast<std::uint64_t>(n);
+  ar(v);
+  if constexpr (Archive::kLoading) {
+    n = v <= max ? static_cast<std::size_t>(v) : 0;
+    if (v > max) ar.Fail();
+  }
+}
+
+// A store sized at Init: its size is written, and a reader of a store of another size fails.
+template <class Archive>
+void IoSameSize(Archive& ar, std::size_t size) {
+  auto v = static_cast<std::uint64_t>(size);
+  ar(v);
+  if constexpr (Archive::kLoading) {
+    if (v != size) ar.Fail();
+  }
+}
+
 }  // namespace msgraphs

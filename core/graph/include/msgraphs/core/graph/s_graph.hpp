@@ -284,8 +284,8 @@ class SGraph {
   /// Rebuilds the graph's Ceres problem from its own records, nodes and factors added newest
   /// slot first, so that Ceres holds them in another order at other addresses. Nothing the
   /// graph computes depends on that order, so it solves as before, bit for bit (tested); a
-  /// snapshot's load rebuilds the problem the same way. kWouldBlock while a job borrows from
-  /// the graph. Allocates.
+  /// snapshot's load builds the problem afresh from the records too (in slot order).
+  /// kWouldBlock while a job borrows from the graph. Allocates.
   Status RebuildProblem();
 
   // ---- snapshots (s_graph_snapshot.cpp, docs/s-graph.md "Snapshots") ----
@@ -299,8 +299,10 @@ class SGraph {
   Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
   /// Replaces this graph by a snapshot. kInvalidArgument, with the graph unchanged, for bytes
   /// that are not a whole snapshot of this version (CRC-32 checked) or that were made with
-  /// another config; a snapshot whose records do not hold together leaves the graph empty (as
-  /// Init left it). kWouldBlock while a job borrows from the graph. Allocates (Ceres' problem).
+  /// another config; a snapshot whose records do not hold together (links, free lists, counts,
+  /// each factor's kind, loss and nodes against its record) leaves the graph empty (as Init left
+  /// it). Either way the revision moves past the graph's before. kWouldBlock while a job borrows
+  /// from the graph. Allocates (Ceres' problem).
   Status Load(std::span<const std::uint8_t> in);
 
   // ---- the full solve in the background (s_graph_solve_job.hpp) ----

@@ -17,6 +17,11 @@
 
 #include "msgraphs/base/expected.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 struct FreeSpaceGridConfig {
@@ -36,6 +41,10 @@ struct FreeSpaceGridConfig {
 
 class FreeSpaceGrid {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   enum class Cell : std::uint8_t { kUnknown, kFree, kOccupied };
 
   Status Init(const FreeSpaceGridConfig& config);
@@ -75,6 +84,8 @@ class FreeSpaceGrid {
   void Clear();
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   void Ray(int x0, int y0, int x1, int y1, bool mark_end_free, bool descending);
   template <typename T>
   void Shift(std::vector<T>& cells, int dx, int dy) const;

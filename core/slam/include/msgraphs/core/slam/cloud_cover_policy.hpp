@@ -29,10 +29,19 @@
 #include "msgraphs/core/graph/s_graph.hpp"
 #include "msgraphs/core/slam/keyframe_cloud_store.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 class CloudCoverPolicy final : public CloudRetentionPolicy {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   /// `slots`: keyframe ids are below it; `pinned`: the newest keyframes never evicted.
   void Init(std::size_t slots, std::size_t pinned, double first_cell_m, double max_cell_m);
   /// What the next Put judges against: the store, the graph, the keyframes' sequences and the
@@ -48,6 +57,8 @@ class CloudCoverPolicy final : public CloudRetentionPolicy {
   std::uint64_t coarsenings() const { return coarsenings_; }
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   std::int64_t CellOf(std::uint32_t key) const;
   bool Recent(std::uint32_t key) const;
 

@@ -25,6 +25,11 @@
 
 #include "msgraphs/base/expected.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 struct FitnessGateConfig {
@@ -37,6 +42,10 @@ struct FitnessGateConfig {
 
 class FitnessGate {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   Status Init(const FitnessGateConfig& config);
   /// A judged match's fitness (non-finite or negative values are ignored and counted).
   void Add(double fitness_m2);
@@ -47,6 +56,8 @@ class FitnessGate {
   void Reset();
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   FitnessGateConfig config_;
   std::vector<double> ring_, scratch_;
   std::size_t next_ = 0, count_ = 0;

@@ -21,6 +21,11 @@
 
 #include "msgraphs/base/expected.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 /// What making room may do with one stored cloud.
@@ -60,6 +65,10 @@ struct KeyframeCloudStoreStats {
 
 class KeyframeCloudStore {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   /// `max_keys`: keyframe ids are below it; `max_points`: the block; `reclaim_points`: the
   /// least a pass frees (0: what the new cloud needs; at most max_points).
   void Init(std::size_t max_keys, std::size_t max_points, std::size_t reclaim_points = 0);
@@ -80,6 +89,8 @@ class KeyframeCloudStore {
   const KeyframeCloudStoreStats& stats() const { return stats_; }
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   struct Entry {
     std::size_t offset = 0, count = 0;
     std::uint64_t sequence = 0;

@@ -338,6 +338,22 @@ class LocalMapper {
   /// completed and applied first.
   Status Finish();
 
+  // ---- snapshots (local_mapper_snapshot.cpp, docs/s-graph.md "Snapshots") ----
+  /// The most bytes Save can write for this mapper's config.
+  std::size_t SnapshotBytes() const;
+  /// Writes the mapper's state between two scans (the graph's snapshot, the odometry, the cloud
+  /// store, the descriptors, the free-space grid, the plane extents, the counters). Loaded into
+  /// a mapper initialised with the same config, the same scans make the same map, bit for bit.
+  /// Taken after a keyframe, as the node does. kWouldBlock while a background solve is pending
+  /// (take it after the solve was applied); kCapacityExceeded when `out` is too small
+  /// (SnapshotBytes always suffices). Allocates nothing.
+  Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
+  /// Replaces this mapper's state by a snapshot. kInvalidArgument with the mapper unchanged for
+  /// bytes that are not a whole snapshot of this version (CRC-32) or whose graph has another
+  /// config; one whose parts do not fit this mapper's stores leaves it as Init left it.
+  /// Allocates (the graph's Ceres problem).
+  Status Load(std::span<const std::uint8_t> in);
+
   /// The background full solve when one is begun and nobody has run it yet, for a worker
   /// thread to take (TryClaim, then Run); nullptr otherwise. The mapper must outlive the worker's
   /// use of it. See full_solve_lag_keyframes.
@@ -422,6 +438,8 @@ class LocalMapper {
   void ScheduleFullSolve(bool loop);
   void ApplyBackgroundSolve();
   void BeginBackgroundSolve();
+  template <class Archive>
+  void Io(Archive& ar);  // the snapshot's own fields (local_mapper_snapshot.cpp)
 
   LocalMapperConfig config_;
   SGraph graph_;

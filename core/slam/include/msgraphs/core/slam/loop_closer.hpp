@@ -27,6 +27,11 @@
 #include "msgraphs/core/registration/gaussian_voxel_map.hpp"
 #include "msgraphs/core/registration/vgicp.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 /// VGICP settings whose fitness counts only points within `max_distance_m` of the target: two
@@ -72,6 +77,10 @@ struct LoopClosureStats {
 
 class LoopCloser {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   /// `max_points`: the largest stored cloud.
   Status Init(std::size_t max_keyframes, std::size_t max_points, const LoopClosureConfig& config);
 
@@ -107,6 +116,8 @@ class LoopCloser {
   const LoopClosureStats& stats() const { return stats_; }
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   using CloudFn = std::span<const Eigen::Vector3f> (*)(const void*, std::uint32_t, std::uint64_t);
   bool DetectImpl(SGraph& graph,
                   std::uint32_t keyframe,

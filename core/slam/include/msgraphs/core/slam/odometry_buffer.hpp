@@ -11,6 +11,11 @@
 
 #include "msgraphs/base/expected.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 struct OdometryLookup {
@@ -29,6 +34,10 @@ struct OdometryBufferStats {
 
 class OdometryBuffer {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   void Init(std::size_t capacity, double max_gap_s = 0.1);
 
   Status Add(double stamp_s, const Eigen::Isometry3d& T_odom_base);
@@ -48,6 +57,8 @@ class OdometryBuffer {
   const OdometryBufferStats& stats() const { return stats_; }
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   std::size_t Index(std::size_t i) const { return (head_ + i) % stamps_.size(); }  // i: 0 = oldest
   std::vector<double> stamps_;
   std::vector<Eigen::Isometry3d> poses_;

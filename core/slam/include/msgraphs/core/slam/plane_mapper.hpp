@@ -26,6 +26,11 @@
 #include "msgraphs/core/perception/plane_extraction.hpp"
 #include "msgraphs/core/perception/room_segmentation.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 struct PlaneAssociationConfig {
@@ -77,6 +82,10 @@ Eigen::Matrix3d PlaneObservationCovariance(const ExtractedPlane& p, double floor
 
 class PlaneMapper {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   Status Init(std::size_t max_planes, const PlaneAssociationConfig& config);
 
   /// Associates the keyframe's planes (keyframe frame) through the graph's current estimate of
@@ -95,6 +104,8 @@ class PlaneMapper {
   const PlaneAssociationStats& stats() const { return stats_; }
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   PlaneAssociationConfig config_;
   std::vector<WallExtent> extents_;
   PlaneAssociationStats stats_;

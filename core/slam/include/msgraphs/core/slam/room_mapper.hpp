@@ -24,6 +24,11 @@
 #include "msgraphs/core/perception/room_segmentation.hpp"
 #include "msgraphs/core/slam/plane_mapper.hpp"
 
+namespace msgraphs {
+class SnapshotReader;
+class SnapshotWriter;
+}  // namespace msgraphs
+
 namespace msgraphs::core {
 
 struct RoomMapperConfig {
@@ -46,6 +51,10 @@ struct RoomMapperStats {
 
 class RoomMapper {
  public:
+  /// Its state in a snapshot (LocalMapper::Save / Load): the reader fails on a store of another
+  /// size or a value out of range.
+  void Save(SnapshotWriter& w) const;
+  void Load(SnapshotReader& r);
   Status Init(const FreeSpaceGridConfig& grid,
               std::size_t max_walls,
               std::size_t max_rooms,
@@ -57,6 +66,8 @@ class RoomMapper {
   const RoomMapperStats& stats() const { return stats_; }
 
  private:
+  template <class Archive>
+  void Io(Archive& ar);
   bool HasWallPair(std::uint32_t a, std::uint32_t b) const;
   void TieSameWalls(SGraph& graph, const MapRoom& mapped, const MapRoom& detected);
 
