@@ -163,8 +163,9 @@ bool Distiller::BeginMarginals(const SGraph& graph) {
 }
 
 void Distiller::MarginalsNow(const SGraph& graph) {
-  // On the graph's own problem, as before the background path existed (the job's copy gives
-  // the same to rounding; this keeps the evaluation's lock-step missions bit for bit).
+  // The graph's marginals job run at once (SGraph::PlaneMarginals): the same covariances the
+  // background path computes for the same graph, whatever the heap did, so the evaluation's
+  // lock-step missions are bit for bit from one run to the next.
   // A failure passes no covariances: StoreMarginals counts it (eligible_ is never empty here).
   const bool ok = static_cast<bool>(graph.PlaneMarginals(eligible_.span(), now_));
   StoreMarginals(eligible_.span(),

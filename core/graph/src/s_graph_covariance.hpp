@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Marginal covariances of planes from a Ceres problem that holds them (SGraph::PlaneMarginals on
-// the graph's own problem, SGraphSolveJob on its copy): one factorisation of the whole problem
+// Marginal covariances of planes from a Ceres problem that holds them (SGraphSolveJob on its
+// copy, which SGraph::PlaneMarginals runs too): one factorisation of the whole problem
 // (SuiteSparse QR), each plane's ambient (normal, offset) block projected on its own (u, v)
 // tangent basis. Allocates (Ceres' covariance): never on a per-keyframe path.
 #pragma once

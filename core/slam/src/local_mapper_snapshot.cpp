@@ -173,10 +173,11 @@ Status LocalMapper::Load(std::span<const std::uint8_t> in) {
   if (length.failed() || graph_bytes > payload.size() - 8)
     return Error{Errc::kInvalidArgument, "mapper snapshot: the graph's length runs past its end"};
   // The graph first: it refuses a snapshot of another config and then changes nothing.
-  const std::size_t slots_before = graph_.keyframe_slots();
+  const std::uint64_t revision_before = graph_.stats().revision;
   if (auto s = graph_.Load(payload.subspan(8, static_cast<std::size_t>(graph_bytes))); !s) {
-    // A graph left empty by records that did not hold together: the mapper follows it.
-    if (graph_.keyframe_slots() != slots_before) static_cast<void>(Init(config_));
+    // A graph left empty by records that did not hold together (its revision moved): the
+    // mapper follows it.
+    if (graph_.stats().revision != revision_before) static_cast<void>(Init(config_));
     return s;
   }
   const auto fail = [this](const char* why) -> Status {
@@ -196,6 +197,12 @@ Status LocalMapper::Load(std::span<const std::uint8_t> in) {
   if (r.failed() || r.remaining() != 0) return fail("mapper snapshot: parts do not fit this mapper");
   if (have_keyframe_ && !graph_.keyframe_active(last_keyframe_))
     return fail("mapper snapshot: its last keyframe is not in its graph");
+  // Factor ids the mapper acts on later: its priors are removed by id (a wrong id would take
+  // another factor out). Pending loops are judged by id, and an id that no longer names a loop
+  // (sparsified meanwhile) is skipped there. No job is pending, so no loop is in one.
+  for (std::uint32_t f : prior_factors_)
+    if (!graph_.IsPlanePriorFactor(f)) return fail("mapper snapshot: a prior id names no prior");
+  if (!job_loops_.empty()) return fail("mapper snapshot: loops of a solve that is not pending");
   // What each scan rebuilds: nothing prepared, the local map of the last keyframe built as
   // the keyframe before the snapshot built it.
   prepared_ = false;

@@ -341,6 +341,8 @@ class SGraph {
   Expected<double> FactorChi2(const SGraphSolveJob& job, std::uint32_t factor) const;
   /// Whether `factor` is an active loop-closure factor (a factor id kept across keyframes may
   /// have been freed by sparsification and reused by another factor).
+  /// Whether `factor` is an active plane prior (AddPlanePrior).
+  bool IsPlanePriorFactor(std::uint32_t factor) const;
   bool IsLoopFactor(std::uint32_t factor) const;
 
   // ---- state ----
@@ -361,7 +363,11 @@ class SGraph {
   /// Marginal covariances of planes `ids` from the whole optimisation (the uncertainty of the
   /// keyframes that saw them included), over (alpha, beta, delta_d) along each plane's basis_u /
   /// basis_v. kDegenerate when the problem is rank deficient; kInvalidArgument for a plane with
-  /// no live observation (its marginal is undefined). Allocates (Ceres): call it at the
+  /// no live observation (its marginal is undefined); kCapacityExceeded for more planes than
+  /// max_planes; kWouldBlock when every job slot borrows the graph already. It runs a marginals
+  /// job (BeginPlaneMarginals, kAll) at once, made at its first call after Init (about 5 MB at
+  /// the default config, outside store_bytes), so its result never depends on where the heap
+  /// put the graph's stores. The graph's thread only. Allocates (Ceres): call it at the
   /// distillation cadence, not on the per-keyframe path.
   Status PlaneMarginals(std::span<const std::uint32_t> ids,
                         std::span<Eigen::Matrix3d> covariances) const;
