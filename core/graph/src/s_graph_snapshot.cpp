@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <vector>
 #include <cstring>
@@ -576,6 +577,21 @@ struct SGraph::SnapshotAccess {
     }
     for (std::size_t k = 0; k < kfs; ++k)
       if (m.keyframes[k].active && m.keyframes[k].loop_factors != loops[k]) return false;
+    // Estimates finite, as the graph keeps them (a solve that leaves any non-finite is undone).
+    const auto finite = [](const double* v, int n) {
+      for (int i = 0; i < n; ++i)
+        if (!std::isfinite(v[i])) return false;
+      return true;
+    };
+    for (std::size_t k = 0; k < kfs; ++k) {
+      const KeyframeNode& node = m.keyframes[k];
+      if (node.active && !(finite(node.q, 4) && finite(node.t, 3))) return false;
+    }
+    for (std::size_t p = 0; p < m.plane_count; ++p)
+      if (m.planes[p].in_problem && !(finite(m.planes[p].n, 3) && finite(m.planes[p].d, 1))) return false;
+    for (std::size_t r = 0; r < m.room_count; ++r)
+      if (m.rooms[r].in_problem && !finite(m.rooms[r].c, 2)) return false;
+    if (m.floor_active && !finite(m.floor_c, 2)) return false;
     for (std::size_t p = 0; p < m.plane_count; ++p)
       if (m.planes[p].info.live_observations != observations[p]) return false;
     const SGraphStats& st = m.stats;

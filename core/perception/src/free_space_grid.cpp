@@ -231,7 +231,8 @@ void FreeSpaceGrid::Io(Archive& ar) {
     // Follow moves at most four widths a step; a mission's worth is far below this bound,
     // which keeps the sums in int.
     constexpr int kMaxMovedCells = 1 << 24;
-    if (std::abs(moved_cells_.x()) > kMaxMovedCells || std::abs(moved_cells_.y()) > kMaxMovedCells) {
+    const auto out = [](int v) { return v < -kMaxMovedCells || v > kMaxMovedCells; };
+    if (out(moved_cells_.x()) || out(moved_cells_.y())) {
       ar.Fail();
       moved_cells_.setZero();
     }

@@ -12,6 +12,7 @@ namespace {
 std::int64_t PackCell(double x, double y, double z) {
   constexpr double kHalf = 1 << 20;
   const auto part = [](double v) {
+    if (!std::isfinite(v)) return std::int64_t{0};  // a pose the graph would refuse: one cell
     const double c = std::clamp(std::floor(v) + kHalf, 0.0, 2 * kHalf - 1);
     return static_cast<std::int64_t>(c);
   };

@@ -21,7 +21,7 @@ namespace msgraphs::core {
 namespace {
 
 constexpr std::array<std::uint8_t, 8> kMagic{'M', 'S', 'G', 'L', 'M', 'A', 'P', 'R'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: config-derived values no longer in it
 constexpr std::size_t kHeaderBytes = 8 + 4 + 8 + 4;
 
 template <class Archive>

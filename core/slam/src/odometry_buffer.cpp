@@ -80,8 +80,10 @@ void OdometryBuffer::Io(Archive& ar) {
   ar(stats_);  // max_gap_s_ is the config's (Init)
   if constexpr (Archive::kLoading) {
     // Interpolation divides by the step between stamps: they rise, as Add keeps them.
-    for (std::size_t i = 1; i < size_; ++i)
-      if (!(stamps_[Index(i)] > stamps_[Index(i - 1)])) ar.Fail();
+    for (std::size_t i = 0; i < size_; ++i) {
+      if (!std::isfinite(stamps_[Index(i)]) || (i > 0 && !(stamps_[Index(i)] > stamps_[Index(i - 1)])))
+        ar.Fail();
+    }
   }
 }
 

@@ -301,8 +301,9 @@ class SGraph {
   /// that are not a whole snapshot of this version (CRC-32 checked) or that were made with
   /// another config; a snapshot whose records do not hold together (links, free lists, counts,
   /// each factor's kind, loss and nodes against its record) leaves the graph empty (as Init left
-  /// it). Either way the revision moves past the graph's before. kWouldBlock while a job borrows
-  /// from the graph. Allocates (Ceres' problem).
+  /// it). A load that replaced the graph (loaded, or left it empty) moves its revision past the
+  /// one before; a refusal that left it unchanged does not. kWouldBlock while a job borrows from
+  /// the graph. Allocates (Ceres' problem).
   Status Load(std::span<const std::uint8_t> in);
 
   // ---- the full solve in the background (s_graph_solve_job.hpp) ----
@@ -341,9 +342,9 @@ class SGraph {
   Expected<double> FactorChi2(const SGraphSolveJob& job, std::uint32_t factor) const;
   /// Whether `factor` is an active loop-closure factor (a factor id kept across keyframes may
   /// have been freed by sparsification and reused by another factor).
+  bool IsLoopFactor(std::uint32_t factor) const;
   /// Whether `factor` is an active plane prior (AddPlanePrior).
   bool IsPlanePriorFactor(std::uint32_t factor) const;
-  bool IsLoopFactor(std::uint32_t factor) const;
 
   // ---- state ----
   std::size_t keyframe_slots() const;  ///< ids handed out so far (active or sparsified)
