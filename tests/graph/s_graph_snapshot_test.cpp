@@ -137,7 +137,37 @@ void Exercise(SGraph& g) {
   }
   static_cast<void>(g.Solve(SolveKind::kLocal));
   static_cast<void>(g.Solve(SolveKind::kFull));
-  for (std::uint32_t r = 0; r < g.room_slots(); ++r) static_cast<void>(g.RemoveRoom(r));
+  SGraphSolveJob job;
+  if (job.Init(MixedMissionConfig()) && g.BeginFullSolve(job)) {
+    job.Complete();
+    static_cast<void>(g.ApplyFullSolve(job));
+  }
+  std::vector<std::uint32_t> planes;
+  for (std::uint32_t p = 0; p < g.plane_slots(); ++p) {
+    if (have_newest) {
+      PlaneMeasurement z;
+      z.normal = g.plane(p).normal;
+      z.d = g.plane(p).d;
+      z.basis_u = z.normal.unitOrthogonal();
+      z.basis_v = z.normal.cross(z.basis_u);
+      z.covariance = Eigen::Matrix3d::Identity() * 1e-4;
+      static_cast<void>(g.AddPlaneObservation(newest, p, z));
+    }
+    if (g.plane(p).live_observations > 0) planes.push_back(p);
+  }
+  std::vector<Eigen::Matrix3d> covariances(planes.size());
+  static_cast<void>(g.PlaneMarginals(planes, covariances));
+  for (std::uint32_t r = 0; r < g.room_slots(); ++r) {
+    MapRoom room = g.room(r);
+    static_cast<void>(g.UpdateRoom(r, room));
+    static_cast<void>(g.RemoveRoom(r));
+  }
+  for (std::uint32_t f = 0; f < 64; ++f) static_cast<void>(g.RemoveFactor(f));
+  for (std::uint32_t k = g.FirstKeyframe(); k != SGraph::kNoKeyframe;) {
+    const std::uint32_t next = g.NextKeyframe(k);
+    static_cast<void>(g.RemoveKeyframe(k));
+    k = next;
+  }
   std::vector<std::uint8_t> bytes(g.SnapshotBytes());
   static_cast<void>(g.Save(bytes));
 }

@@ -92,7 +92,11 @@ Status SGraph::Init(const SGraphConfig& config) {
   m.scratch_costs.reserve(1024);  // the residual blocks on one node (RemoveBlock)
   m.snapshot.assign(
       (config.max_keyframes + 1) * 7 + config.max_planes * 4 + config.max_rooms * 2 + 2, 0.0);
+  // The revision goes on from the graph's before: a reader that saw an earlier graph of this
+  // object never takes the new one for it.
+  const std::uint64_t revision = m.stats.revision;
   m.stats = SGraphStats{};
+  m.stats.revision = revision + 1;
   m.stats.store_bytes =
       m.keyframes.size() * sizeof(KeyframeNode) + m.planes.size() * sizeof(PlaneNode) +
       m.rooms.size() * sizeof(RoomNode) + m.factors.size() * sizeof(FactorRecord) +
@@ -189,6 +193,12 @@ Expected<double> SGraph::FactorChi2(std::uint32_t factor) const {
     return Error{Errc::kDegenerate, "factor could not be evaluated"};
   }
   return 2.0 * cost;  // Ceres' cost is half the squared norm
+}
+
+bool SGraph::IsPlanePriorFactor(std::uint32_t factor) const {
+  const Impl& m = *impl_;
+  return factor < m.factor_high_water && m.factors[factor].active &&
+         m.factors[factor].kind == FactorKind::kPlanePrior;
 }
 
 bool SGraph::IsLoopFactor(std::uint32_t factor) const {

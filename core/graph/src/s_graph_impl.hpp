@@ -143,6 +143,8 @@ inline void StorePose(const Eigen::Isometry3d& T, double* q, double* t) {
   for (int i = 0; i < 3; ++i) t[i] = T.translation()[i];
 }
 
+// A problem that borrows the graph's costs, losses and manifolds (s_graph_solve.cpp).
+ceres::Problem::Options BorrowingProblemOptions();
 // The solver's options for either solve (s_graph_solve.cpp).
 ceres::Solver::Options SolverOptions(const SGraphConfig& config, SolveKind kind);
 // The solver stopped with a state worth keeping (converged, or at its limits, with a finite cost).

@@ -15,21 +15,23 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <vector>
 #include <cstring>
 
 #include "msgraphs/base/crc32.hpp"
 #include "msgraphs/base/snapshot_archive.hpp"
+#include "msgraphs/base/snapshot_header.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
 #include "s_graph_impl.hpp"
 
 namespace msgraphs::core {
 namespace {
 
-constexpr std::array<std::uint8_t, 8> kMagic{'M', 'S', 'G', 'S', 'G', 'R', 'P', 'H'};
+constexpr SnapshotMagic kMagic{'M', 'S', 'G', 'S', 'G', 'R', 'P', 'H'};
 constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kHeaderBytes = 8 + 4 + 8 + 4;
+constexpr std::size_t kHeaderBytes = kSnapshotHeaderBytes;
 constexpr std::size_t kMaxBlocks = 9;   // a four-wall room: centre and four walls' two blocks
 constexpr std::size_t kMaxValues = 43;  // a relative pose: rotation, translation, 6x6 root
 
@@ -576,6 +578,21 @@ struct SGraph::SnapshotAccess {
     }
     for (std::size_t k = 0; k < kfs; ++k)
       if (m.keyframes[k].active && m.keyframes[k].loop_factors != loops[k]) return false;
+    // Estimates finite, as the graph keeps them (a solve that leaves any non-finite is undone).
+    const auto finite = [](const double* v, int n) {
+      for (int i = 0; i < n; ++i)
+        if (!std::isfinite(v[i])) return false;
+      return true;
+    };
+    for (std::size_t k = 0; k < kfs; ++k) {
+      const KeyframeNode& node = m.keyframes[k];
+      if (node.active && !(finite(node.q, 4) && finite(node.t, 3))) return false;
+    }
+    for (std::size_t p = 0; p < m.plane_count; ++p)
+      if (m.planes[p].in_problem && !(finite(m.planes[p].n, 3) && finite(m.planes[p].d, 1))) return false;
+    for (std::size_t r = 0; r < m.room_count; ++r)
+      if (m.rooms[r].in_problem && !finite(m.rooms[r].c, 2)) return false;
+    if (m.floor_active && !finite(m.floor_c, 2)) return false;
     for (std::size_t p = 0; p < m.plane_count; ++p)
       if (m.planes[p].info.live_observations != observations[p]) return false;
     const SGraphStats& st = m.stats;
@@ -620,12 +637,7 @@ Expected<std::size_t> SGraph::Save(std::span<std::uint8_t> out) const {
   IoList(w, m.plane_only_factors, m.factors.size());
   if (w.failed()) return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
   const std::span<const std::uint8_t> payload = out.subspan(kHeaderBytes, w.size());
-  SnapshotWriter h(out.first(kHeaderBytes));
-  h(kMagic.data(), kMagic.size());
-  h(kVersion);
-  h(static_cast<std::uint64_t>(payload.size()));
-  h(Crc32(payload));
-  return kHeaderBytes + payload.size();
+  return WriteSnapshotHeader(out, kMagic, kVersion, payload.size());
 }
 
 Status SGraph::Load(std::span<const std::uint8_t> in) {
@@ -634,22 +646,9 @@ Status SGraph::Load(std::span<const std::uint8_t> in) {
   if (m.OldestBorrower() != Impl::kNoBorrower || m.full_job_pending)
     return Error{Errc::kWouldBlock, "a job borrows from this graph"};
   // The header and the whole payload are checked before anything changes.
-  SnapshotReader h(in);
-  std::array<std::uint8_t, 8> magic{};
-  std::uint32_t version = 0, crc = 0;
-  std::uint64_t bytes = 0;
-  h(magic.data(), magic.size());
-  h(version);
-  h(bytes);
-  h(crc);
-  if (h.failed() || magic != kMagic)
-    return Error{Errc::kInvalidArgument, "s-graph snapshot: not a snapshot"};
-  if (version != kVersion)
-    return Error{Errc::kInvalidArgument, "s-graph snapshot: another version"};
-  if (bytes != in.size() - kHeaderBytes)
-    return Error{Errc::kInvalidArgument, "s-graph snapshot: truncated or overlong"};
-  const std::span<const std::uint8_t> payload = in.subspan(kHeaderBytes);
-  if (Crc32(payload) != crc) return Error{Errc::kInvalidArgument, "s-graph snapshot: CRC mismatch"};
+  auto checked = SnapshotPayload(in, kMagic, kVersion);
+  if (!checked) return checked.error();
+  const std::span<const std::uint8_t> payload = *checked;
   SnapshotReader r(payload);
   SGraphConfig saved;
   Io(r, saved);

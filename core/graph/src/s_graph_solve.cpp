@@ -90,13 +90,18 @@ std::size_t SGraph::Impl::CollectWindow() {
   return free_keyframes;
 }
 
-void SGraph::Impl::BuildWindowProblem() {
+// A problem that borrows everything: the graph owns the costs, losses and manifolds.
+ceres::Problem::Options sgraph::BorrowingProblemOptions() {
   ceres::Problem::Options options;
-  // The graph's problem owns them all; the window only borrows (its own sums: window_costs).
   options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  window = std::make_unique<ceres::Problem>(options);
+  return options;
+}
+
+void SGraph::Impl::BuildWindowProblem() {
+  // The graph's problem owns them all; the window only borrows (its own sums: window_costs).
+  window = std::make_unique<ceres::Problem>(sgraph::BorrowingProblemOptions());
   window_costs.clear();
   const auto is_free = [this](const double* block) {
     return std::binary_search(window_free.begin(), window_free.end(), block);
@@ -171,11 +176,7 @@ void SGraph::Impl::BuildWindowProblem() {
 }
 
 void SGraph::Impl::BuildFullProblem() {
-  ceres::Problem::Options options;
-  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  window = std::make_unique<ceres::Problem>(options);
+  window = std::make_unique<ceres::Problem>(sgraph::BorrowingProblemOptions());
   window_costs.clear();
   const auto add_block = [this](double* block) {
     window->AddParameterBlock(block, problem->ParameterBlockSize(block),
@@ -297,11 +298,8 @@ Status SGraph::RebuildProblem() {
   if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
   if (m.OldestBorrower() != Impl::kNoBorrower || m.full_job_pending)
     return Error{Errc::kWouldBlock, "a job borrows from this graph"};
-  ceres::Problem::Options options;
-  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.enable_fast_removal = true;
+  ceres::Problem::Options options = sgraph::BorrowingProblemOptions();
+  options.enable_fast_removal = true;  // as the graph's own (Init)
   auto rebuilt = std::make_unique<ceres::Problem>(options);
   const auto add_block = [&](double* block) {
     if (!m.problem->HasParameterBlock(block)) return;

@@ -224,9 +224,20 @@ void FreeSpaceGrid::Io(Archive& ar) {
   ar(low_directions_.data(), low_directions_.size());
   ar(outside_);
   ar(moves_);
-  ar(config_.origin_m.data(), 2);
-  ar(origin0_m_.data(), 2);
+  // Where the window has moved to, in whole cells from the configured origin (the config's,
+  // not the snapshot's): the origin follows from it as Follow computes it.
   ar(moved_cells_.data(), 2);
+  if constexpr (Archive::kLoading) {
+    // Follow moves at most four widths a step; a mission's worth is far below this bound,
+    // which keeps the sums in int.
+    constexpr int kMaxMovedCells = 1 << 24;
+    const auto out = [](int v) { return v < -kMaxMovedCells || v > kMaxMovedCells; };
+    if (out(moved_cells_.x()) || out(moved_cells_.y())) {
+      ar.Fail();
+      moved_cells_.setZero();
+    }
+    config_.origin_m = origin0_m_ + moved_cells_.cast<float>() * config_.resolution_m;
+  }
 }
 
 void FreeSpaceGrid::Save(SnapshotWriter& w) const { const_cast<FreeSpaceGrid*>(this)->Io(w); }

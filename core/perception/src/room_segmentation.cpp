@@ -251,8 +251,11 @@ Status RoomSegmenter::DetectRooms(const FreeSpaceGrid& grid, std::span<const Roo
   for (std::size_t w = 0; w < walls.size(); ++w) {
     const MapWall& wall = walls[w];
     if (!wall.normal.allFinite() || !wall.a.allFinite() || !wall.b.allFinite()) continue;
-    const double length = (wall.b - wall.a).norm();
-    const int along = std::max(1, static_cast<int>(length / step));
+    // Sampled a cell apart, never more often than the grid's diagonal holds cells: the rest of
+    // a longer wall lies outside the grid (this also bounds the walk for any extent given).
+    const double length_cells = (wall.b - wall.a).norm() / step;
+    const double diagonal_cells = std::hypot(static_cast<double>(grid.width()), static_cast<double>(grid.height()));
+    const int along = std::max(1, static_cast<int>(std::min(length_cells, diagonal_cells)));
     const int depth = static_cast<int>(static_cast<double>(config.wall_search_m) / step);
     for (int i = 0; i <= along; ++i) {
       const Eigen::Vector2d on = wall.a + (wall.b - wall.a) * (static_cast<double>(i) / along);

@@ -12,6 +12,7 @@ namespace {
 std::int64_t PackCell(double x, double y, double z) {
   constexpr double kHalf = 1 << 20;
   const auto part = [](double v) {
+    if (!std::isfinite(v)) return std::int64_t{0};  // a pose the graph would refuse: one cell
     const double c = std::clamp(std::floor(v) + kHalf, 0.0, 2 * kHalf - 1);
     return static_cast<std::int64_t>(c);
   };
@@ -100,13 +101,22 @@ bool CloudCoverPolicy::Coarsen() {
 
 // Only the cell size persists; the cells and the pinned keyframes are taken afresh each pass,
 // and what the policy judges against is bound again before each Put.
+// The cell is the first (Init's) doubled once per coarsening, up to the config's largest.
 template <class Archive>
 void CloudCoverPolicy::Io(Archive& ar) {
-  ar(cell_m_);
-  ar(max_cell_m_);
-  ar(coarsenings_);
-  if constexpr (Archive::kLoading) {
-    if (!(cell_m_ > 0) || !(max_cell_m_ >= cell_m_)) ar.Fail();
+  if constexpr (!Archive::kLoading) {
+    ar(coarsenings_);
+  } else {
+    const double first_cell_m = std::ldexp(cell_m_, -static_cast<int>(std::min<std::uint64_t>(coarsenings_, 64)));
+    ar(coarsenings_);
+    double cell_m = first_cell_m;
+    for (std::uint64_t i = 0; i < coarsenings_ && i < 64; ++i) cell_m *= 2;
+    if (coarsenings_ >= 64 || cell_m > max_cell_m_) {
+      ar.Fail();
+      coarsenings_ = 0;
+      cell_m = first_cell_m;
+    }
+    cell_m_ = cell_m;
   }
 }
 

@@ -72,6 +72,10 @@ void FitnessGate::Io(Archive& ar) {
   IoCount(ar, next_, ring_.size() - 1);
   IoCount(ar, count_, ring_.size());
   ar(ignored_);
+  if constexpr (Archive::kLoading) {
+    for (double f : ring_)
+      if (!std::isfinite(f) || f < 0) ar.Fail();  // what Add lets in
+  }
 }
 
 void FitnessGate::Save(SnapshotWriter& w) const { const_cast<FitnessGate*>(this)->Io(w); }

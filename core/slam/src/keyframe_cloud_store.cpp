@@ -159,34 +159,47 @@ void KeyframeCloudStore::Io(Archive& ar) {
     ar(e.sequence);
     ar(e.stamp);
     IoBool(ar, e.valid);
-    if constexpr (Archive::kLoading) {
-      if (e.valid && (e.offset > top_ || e.count > top_ - e.offset)) ar.Fail();
-    }
   }
   IoCount(ar, order_size_, order_.size());
   for (std::size_t i = 0; i < order_size_; ++i) {
     ar(order_[i]);
     ar(order_stamp_[i]);
     if constexpr (Archive::kLoading) {
-      if (order_[i] >= entries_.size()) ar.Fail();
+      if (order_[i] >= entries_.size()) {
+        ar.Fail();
+        order_[i] = 0;
+      }
     }
   }
   ar(stamp_);
   IoCount(ar, used_, points_.size());
   IoCount(ar, peak_, points_.size());
   IoCount(ar, live_, entries_.size());
-  IoCount(ar, reclaim_, points_.size());
-  ar(stats_);
+  ar(stats_);  // reclaim_ is the config's (Init)
   if constexpr (Archive::kLoading) {
-    // The counts eviction works from, recomputed: what the entries say is in the store.
-    std::size_t used = 0, live = 0;
-    for (const Entry& e : entries_) {
-      if (!e.valid) continue;
-      used += e.count;
-      ++live;
-    }
-    if (used != used_ || live != live_ || peak_ < used_) ar.Fail();
+    if (!ar.failed() && !Consistent()) ar.Fail();
   }
+}
+
+// What Put, eviction and compaction rely on, as they leave it: the order lists each put once
+// with rising stamps no newer than the store's count; every listed cloud has exactly one live
+// order entry; live clouds lie in order, apart, below top_; the counts are what the entries say.
+bool KeyframeCloudStore::Consistent() const {
+  std::uint64_t last_stamp = 0;
+  std::size_t end = 0, live = 0, used = 0;
+  for (std::size_t i = 0; i < order_size_; ++i) {
+    if (order_stamp_[i] <= last_stamp || order_stamp_[i] > stamp_) return false;
+    last_stamp = order_stamp_[i];
+    if (!Live(i)) continue;
+    const Entry& e = entries_[order_[i]];
+    if (e.offset < end || e.offset > top_ || e.count > top_ - e.offset) return false;
+    end = e.offset + e.count;
+    ++live;
+    used += e.count;
+  }
+  std::size_t valid = 0;
+  for (const Entry& e : entries_) valid += e.valid ? 1u : 0u;
+  return live == valid && live == live_ && used == used_ && peak_ >= used_;
 }
 
 void KeyframeCloudStore::Save(SnapshotWriter& w) const { const_cast<KeyframeCloudStore*>(this)->Io(w); }

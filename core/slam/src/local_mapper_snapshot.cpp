@@ -15,14 +15,15 @@
 
 #include "msgraphs/base/crc32.hpp"
 #include "msgraphs/base/snapshot_archive.hpp"
+#include "msgraphs/base/snapshot_header.hpp"
 #include "msgraphs/core/slam/local_mapper.hpp"
 
 namespace msgraphs::core {
 namespace {
 
-constexpr std::array<std::uint8_t, 8> kMagic{'M', 'S', 'G', 'L', 'M', 'A', 'P', 'R'};
-constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kHeaderBytes = 8 + 4 + 8 + 4;
+constexpr SnapshotMagic kMagic{'M', 'S', 'G', 'L', 'M', 'A', 'P', 'R'};
+constexpr std::uint32_t kVersion = 2;  // 2: config-derived values no longer in it
+constexpr std::size_t kHeaderBytes = kSnapshotHeaderBytes;
 
 template <class Archive>
 void IoPose(Archive& ar, Eigen::Isometry3d& T) {
@@ -142,41 +143,26 @@ Expected<std::size_t> LocalMapper::Save(std::span<std::uint8_t> out) const {
   const_cast<LocalMapper*>(this)->Io(w);
   if (w.failed()) return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
   const std::span<const std::uint8_t> payload = out.subspan(kHeaderBytes, 8 + *graph_bytes + w.size());
-  SnapshotWriter h(out.first(kHeaderBytes));
-  h(kMagic.data(), kMagic.size());
-  h(kVersion);
-  h(static_cast<std::uint64_t>(payload.size()));
-  h(Crc32(payload));
-  return kHeaderBytes + payload.size();
+  return WriteSnapshotHeader(out, kMagic, kVersion, payload.size());
 }
 
 Status LocalMapper::Load(std::span<const std::uint8_t> in) {
   if (full_job_.pending())
     return Error{Errc::kWouldBlock, "a background solve is pending"};
-  SnapshotReader h(in);
-  std::array<std::uint8_t, 8> magic{};
-  std::uint32_t version = 0, crc = 0;
-  std::uint64_t bytes = 0, graph_bytes = 0;
-  h(magic.data(), magic.size());
-  h(version);
-  h(bytes);
-  h(crc);
-  if (h.failed() || magic != kMagic)
-    return Error{Errc::kInvalidArgument, "mapper snapshot: not a snapshot"};
-  if (version != kVersion) return Error{Errc::kInvalidArgument, "mapper snapshot: another version"};
-  if (bytes != in.size() - kHeaderBytes)
-    return Error{Errc::kInvalidArgument, "mapper snapshot: truncated or overlong"};
-  const std::span<const std::uint8_t> payload = in.subspan(kHeaderBytes);
-  if (Crc32(payload) != crc) return Error{Errc::kInvalidArgument, "mapper snapshot: CRC mismatch"};
+  auto checked = SnapshotPayload(in, kMagic, kVersion);
+  if (!checked) return checked.error();
+  const std::span<const std::uint8_t> payload = *checked;
+  std::uint64_t graph_bytes = 0;
   SnapshotReader length(payload);
   length(graph_bytes);
   if (length.failed() || graph_bytes > payload.size() - 8)
     return Error{Errc::kInvalidArgument, "mapper snapshot: the graph's length runs past its end"};
   // The graph first: it refuses a snapshot of another config and then changes nothing.
-  const std::size_t slots_before = graph_.keyframe_slots();
+  const std::uint64_t revision_before = graph_.stats().revision;
   if (auto s = graph_.Load(payload.subspan(8, static_cast<std::size_t>(graph_bytes))); !s) {
-    // A graph left empty by records that did not hold together: the mapper follows it.
-    if (graph_.keyframe_slots() != slots_before) static_cast<void>(Init(config_));
+    // A graph left empty by records that did not hold together (its revision moved): the
+    // mapper follows it.
+    if (graph_.stats().revision != revision_before) static_cast<void>(Init(config_));
     return s;
   }
   const auto fail = [this](const char* why) -> Status {
@@ -196,6 +182,12 @@ Status LocalMapper::Load(std::span<const std::uint8_t> in) {
   if (r.failed() || r.remaining() != 0) return fail("mapper snapshot: parts do not fit this mapper");
   if (have_keyframe_ && !graph_.keyframe_active(last_keyframe_))
     return fail("mapper snapshot: its last keyframe is not in its graph");
+  // Factor ids the mapper acts on later: its priors are removed by id (a wrong id would take
+  // another factor out). Pending loops are judged by id, and an id that no longer names a loop
+  // (sparsified meanwhile) is skipped there. No job is pending, so no loop is in one.
+  for (std::uint32_t f : prior_factors_)
+    if (!graph_.IsPlanePriorFactor(f)) return fail("mapper snapshot: a prior id names no prior");
+  if (!job_loops_.empty()) return fail("mapper snapshot: loops of a solve that is not pending");
   // What each scan rebuilds: nothing prepared, the local map of the last keyframe built as
   // the keyframe before the snapshot built it.
   prepared_ = false;

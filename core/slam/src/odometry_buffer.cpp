@@ -77,8 +77,14 @@ void OdometryBuffer::Io(Archive& ar) {
   for (Eigen::Isometry3d& T : poses_) ar(T.matrix().data(), 16);
   IoCount(ar, head_, stamps_.size() - 1);
   IoCount(ar, size_, stamps_.size());
-  ar(max_gap_s_);
-  ar(stats_);
+  ar(stats_);  // max_gap_s_ is the config's (Init)
+  if constexpr (Archive::kLoading) {
+    // Interpolation divides by the step between stamps: they rise, as Add keeps them.
+    for (std::size_t i = 0; i < size_; ++i) {
+      if (!std::isfinite(stamps_[Index(i)]) || (i > 0 && !(stamps_[Index(i)] > stamps_[Index(i - 1)])))
+        ar.Fail();
+    }
+  }
 }
 
 void OdometryBuffer::Save(SnapshotWriter& w) const { const_cast<OdometryBuffer*>(this)->Io(w); }

@@ -204,6 +204,13 @@ void PlaneMapper::Io(Archive& ar) {
     ar(e.z_min);
     ar(e.z_max);
     IoBool(ar, e.valid);
+    if constexpr (Archive::kLoading) {
+      // Finite and ordered, as observations leave an extent (room segmentation bounds its
+      // walk along a wall by the grid's size, whatever the length).
+      if (e.valid && !(e.a.allFinite() && e.b.allFinite() && std::isfinite(e.z_min) &&
+                       std::isfinite(e.z_max) && e.z_min <= e.z_max))
+        ar.Fail();
+    }
   }
   ar(stats_);
 }

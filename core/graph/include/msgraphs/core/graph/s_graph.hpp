@@ -301,8 +301,9 @@ class SGraph {
   /// that are not a whole snapshot of this version (CRC-32 checked) or that were made with
   /// another config; a snapshot whose records do not hold together (links, free lists, counts,
   /// each factor's kind, loss and nodes against its record) leaves the graph empty (as Init left
-  /// it). Either way the revision moves past the graph's before. kWouldBlock while a job borrows
-  /// from the graph. Allocates (Ceres' problem).
+  /// it). A load that replaced the graph (loaded, or left it empty) moves its revision past the
+  /// one before; a refusal that left it unchanged does not. kWouldBlock while a job borrows from
+  /// the graph. Allocates (Ceres' problem).
   Status Load(std::span<const std::uint8_t> in);
 
   // ---- the full solve in the background (s_graph_solve_job.hpp) ----
@@ -342,6 +343,8 @@ class SGraph {
   /// Whether `factor` is an active loop-closure factor (a factor id kept across keyframes may
   /// have been freed by sparsification and reused by another factor).
   bool IsLoopFactor(std::uint32_t factor) const;
+  /// Whether `factor` is an active plane prior (AddPlanePrior).
+  bool IsPlanePriorFactor(std::uint32_t factor) const;
 
   // ---- state ----
   std::size_t keyframe_slots() const;  ///< ids handed out so far (active or sparsified)
@@ -361,7 +364,11 @@ class SGraph {
   /// Marginal covariances of planes `ids` from the whole optimisation (the uncertainty of the
   /// keyframes that saw them included), over (alpha, beta, delta_d) along each plane's basis_u /
   /// basis_v. kDegenerate when the problem is rank deficient; kInvalidArgument for a plane with
-  /// no live observation (its marginal is undefined). Allocates (Ceres): call it at the
+  /// no live observation (its marginal is undefined); kCapacityExceeded for more planes than
+  /// max_planes; kWouldBlock when every job slot borrows the graph already. It runs a marginals
+  /// job (BeginPlaneMarginals, kAll) at once, made at its first call after Init (about 5 MB at
+  /// the default config, outside store_bytes), so its result never depends on where the heap
+  /// put the graph's stores. The graph's thread only. Allocates (Ceres): call it at the
   /// distillation cadence, not on the per-keyframe path.
   Status PlaneMarginals(std::span<const std::uint32_t> ids,
                         std::span<Eigen::Matrix3d> covariances) const;

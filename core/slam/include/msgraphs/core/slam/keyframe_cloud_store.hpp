@@ -98,6 +98,7 @@ class KeyframeCloudStore {
     bool valid = false;
   };
   bool Live(std::size_t order_index) const;
+  bool Consistent() const;  // a loaded snapshot's entries hold together (snapshot Load)
   void Evict(std::uint32_t key, const CloudRetentionPolicy* policy, CloudRetention why);
   /// Evicts, oldest first, until `need` points are free at the top (after sliding).
   void MakeRoom(std::size_t need, CloudRetentionPolicy* policy);

@@ -344,14 +344,17 @@ class LocalMapper {
   /// Writes the mapper's state between two scans (the graph's snapshot, the odometry, the cloud
   /// store, the descriptors, the free-space grid, the plane extents, the counters). Loaded into
   /// a mapper initialised with the same config, the same scans make the same map, bit for bit.
-  /// Taken after a keyframe, as the node does. kWouldBlock while a background solve is pending
-  /// (take it after the solve was applied); kCapacityExceeded when `out` is too small
+  /// Meant for just after a keyframe (the node's snapshot writer is not built yet). The config
+  /// itself is not in it: the graph's is checked, the rest (spacing, voxel sizes, thresholds)
+  /// is the caller's to keep the same (the node: its config file's CRC). kWouldBlock while a
+  /// background full solve is pending or any job borrows the graph, such as the distiller's
+  /// marginals (save after it ended); kCapacityExceeded when `out` is too small
   /// (SnapshotBytes always suffices). Allocates nothing.
   Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
   /// Replaces this mapper's state by a snapshot. kInvalidArgument with the mapper unchanged for
   /// bytes that are not a whole snapshot of this version (CRC-32) or whose graph has another
-  /// config; one whose parts do not fit this mapper's stores leaves it as Init left it.
-  /// Allocates (the graph's Ceres problem).
+  /// config; one whose parts do not fit this mapper's stores or do not hold together leaves it
+  /// as Init left it. Allocates (the graph's Ceres problem).
   Status Load(std::span<const std::uint8_t> in);
 
   /// The background full solve when one is begun and nobody has run it yet, for a worker

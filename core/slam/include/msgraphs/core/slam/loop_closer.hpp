@@ -71,6 +71,7 @@ struct LoopClosureStats {
                 cloud_evicted = 0;
   // The newest accepted loop: its keyframes, fitness and how far it moved the estimate.
   std::uint32_t last_from = 0, last_to = 0, last_factor = 0;
+  std::uint32_t unused_ = 0;  // no padding: the struct is written whole in a snapshot
   std::uint64_t rejected_after_solve = 0;
   double last_fitness_m2 = 0, last_correction_m = 0;
 };

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// A snapshot's header (the S-Graph's, the mapper's): magic (8 bytes), version u32, payload
+// length u64, CRC-32 of the payload, then the payload. Host byte order, as the archive.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "msgraphs/base/crc32.hpp"
+#include "msgraphs/base/expected.hpp"
+#include "msgraphs/base/snapshot_archive.hpp"
+
+namespace msgraphs {
+
+constexpr std::size_t kSnapshotHeaderBytes = 8 + 4 + 8 + 4;
+using SnapshotMagic = std::array<std::uint8_t, 8>;
+
+/// Writes the header for the payload that follows it in `out`; returns the whole length.
+inline std::size_t WriteSnapshotHeader(std::span<std::uint8_t> out, const SnapshotMagic& magic,
+                                       std::uint32_t version, std::size_t payload_bytes) {
+  const auto payload = std::span<const std::uint8_t>(out).subspan(kSnapshotHeaderBytes, payload_bytes);
+  SnapshotWriter h(out.first(kSnapshotHeaderBytes));
+  h(magic.data(), magic.size());
+  h(version);
+  h(static_cast<std::uint64_t>(payload.size()));
+  h(Crc32(payload));
+  return kSnapshotHeaderBytes + payload.size();
+}
+
+/// The payload of a whole snapshot of this kind and version; kInvalidArgument otherwise.
+inline Expected<std::span<const std::uint8_t>> SnapshotPayload(std::span<const std::uint8_t> in,
+                                                               const SnapshotMagic& magic,
+                                                               std::uint32_t version) {
+  SnapshotReader h(in);
+  SnapshotMagic read_magic{};
+  std::uint32_t read_version = 0, crc = 0;
+  std::uint64_t bytes = 0;
+  h(read_magic.data(), read_magic.size());
+  h(read_version);
+  h(bytes);
+  h(crc);
+  if (h.failed() || read_magic != magic) return Error{Errc::kInvalidArgument, "snapshot: not one of this kind"};
+  if (read_version != version) return Error{Errc::kInvalidArgument, "snapshot: another version"};
+  if (bytes != in.size() - kSnapshotHeaderBytes)
+    return Error{Errc::kInvalidArgument, "snapshot: truncated or overlong"};
+  const std::span<const std::uint8_t> payload = in.subspan(kSnapshotHeaderBytes);
+  if (Crc32(payload) != crc) return Error{Errc::kInvalidArgument, "snapshot: CRC mismatch"};
+  return payload;
+}
+
+}  // namespace msgraphs
