@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-60}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session node_config pcd_reader)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(velodyne_decoder pcap_reader candump_parser can_decoder collab_messages collab_session node_config pcd_reader checkpoint_files)
 DATA=${MSGRAPHS_DATA_DIR:-$(pwd)/../shared/data}
 
 cmake --preset fuzz >/dev/null
@@ -19,7 +19,7 @@ cmake --build --preset fuzz --target "${TARGETS[@]/#/fuzz_}" >/dev/null
 
 WORK=$(mktemp -d); trap 'rm -rf "$WORK"' EXIT
 mkdir -p build/fuzz/artifacts
-mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session,node_config,pcd_reader}
+mkdir -p "$WORK"/{velodyne_decoder,pcap_reader,candump_parser,can_decoder,collab_messages,collab_session,node_config,pcd_reader,checkpoint_files}
 # The shipped example configuration seeds the config fuzzer.
 cp runtime/node/example.conf "$WORK/node_config/"
 # PCD seeds: a small binary map as the node writes it, an ascii file with an extra field.
@@ -66,6 +66,19 @@ place_cloud = b'MSPC' + struct.pack('<BHHIffffI', 1, 2, 1, 3, 4.0, -2.0, -0.5, 0
 open(f"{d}/place_cloud", 'wb').write(b'\x06' + place_cloud)
 PY
 cp "$WORK"/collab_messages/* "$WORK/collab_session/"
+# Checkpoint seeds: a journal of one odometry record and one two-point scan (shaped records,
+# kind byte 1), and a snapshot head with an empty mapper and one session message (kind 0).
+python3 - "$WORK/checkpoint_files" <<'PY'
+import struct, sys
+d = sys.argv[1]
+odometry = struct.pack('<8d', 10.0, 1, 2, 3, 0, 0, 0, 1)
+scan = struct.pack('<ddI', 9.9, 10.0, 2) + struct.pack('<4H', 1000, 2000, 300, 25000) * 2
+rec = lambda t, p: bytes([t]) + struct.pack('<H', len(p)) + p
+open(f"{d}/journal", 'wb').write(b'\x01' + rec(1, odometry) + rec(2, scan) + rec(4, b''))
+head = struct.pack('<HQI', 1, 3, 7) + struct.pack('<9d', 10.0, 10.0, 0, 0, 0, 0, 0, 0, 1) + struct.pack('<QQ', 0, 0)
+session = struct.pack('<I', 1) + bytes([1]) + struct.pack('<I', 3) + b'abc'
+open(f"{d}/snapshot", 'wb').write(b'\x00' + head + session)
+PY
 
 status=0
 for t in "${TARGETS[@]}"; do

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "alloc_counter.hpp"
@@ -217,6 +218,44 @@ TEST(SGraphSnapshot, ALoadAndTheCallsAfterItStayWithinTheStoresWhateverTheBytesH
   std::printf("changed snapshots: %zu loaded, %zu refused\n", loaded, refused);
   EXPECT_GT(loaded, 0u);
   EXPECT_GT(refused, 0u);
+}
+
+// The node's marginals thread holds a job that borrows the graph's costs across keyframes; the
+// checkpoint's snapshot is taken meanwhile. Both only read: the save goes on, the same bytes as
+// without the job, while a load (which would free the costs the job evaluates) waits.
+TEST(SGraphSnapshot, AMarginalsJobBorrowingDoesNotStopASaveButStopsALoad) {
+  std::size_t checked = 0;
+  RunMixedMission([&](std::unique_ptr<SGraph>& g, std::size_t i) {
+    if (i != 100) return;
+    std::vector<std::uint32_t> walls;
+    for (std::uint32_t p = 0; p < g->plane_slots() && walls.size() < 8; ++p) {
+      const MapPlane plane = g->plane(p);
+      if (plane.active && plane.live_observations > 0) walls.push_back(p);
+    }
+    ASSERT_FALSE(walls.empty());
+    const std::vector<std::uint8_t> before = SaveOf(*g);
+    SGraphSolveJob job;
+    ASSERT_TRUE(job.Init(MixedMissionConfig()));
+    ASSERT_TRUE(g->BeginPlaneMarginals(job, walls));  // it borrows from here until Run ends
+    EXPECT_EQ(SaveOf(*g), before);
+    const Status load = g->Load(before);
+    ASSERT_FALSE(load);
+    EXPECT_EQ(load.error().code, Errc::kWouldBlock);
+    // And while a worker evaluates the borrowed costs (ASan and TSan builds see any race).
+    ASSERT_TRUE(job.TryClaim());
+    std::vector<std::uint8_t> during(g->SnapshotBytes());
+    Expected<std::size_t> n = Error{Errc::kInvalidArgument};
+    {
+      std::jthread worker([&job] { job.Run(); });
+      n = g->Save(during);
+    }
+    ASSERT_TRUE(n);
+    during.resize(*n);
+    EXPECT_EQ(during, before);
+    ASSERT_TRUE(job.Release());
+    ++checked;
+  });
+  EXPECT_EQ(checked, 1u);
 }
 
 TEST(SGraphSnapshot, NoSaveOrLoadWhileAJobBorrowsAndNoneIntoTooSmallABuffer) {

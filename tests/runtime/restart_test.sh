@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# kill -9 of a node mid-mission, restart from its checkpoint: it resumes its map (nothing of
-# the first part is lost), rejoins the fleet and the maps merge again.
+# kill -9 of a node mid-mission, restart from its checkpoint: it resumes its map from its newest
+# snapshot and the journal since (a generation every 10 keyframes here, so that a 30-keyframe
+# run has several; nothing of the first part is lost), rejoins the fleet and the maps merge.
 #   restart_test.sh <msgraphs_node> <msgraphs_sim> <msgraphs_fleet_ate> <world> <domain>
 set -u
 node=$1; sim=$2; fleet_ate=$3; world=$4; domain=$5
@@ -23,6 +24,8 @@ speed = 2
 [link]
 domain = $domain
 loopback_only = true
+[checkpoint]
+snapshot_every_keyframes = 10
 [runtime]
 status_period_s = 1
 exit_after_done_s = 8
@@ -50,6 +53,10 @@ rc=0
 wait $pid1 || { echo "robot 1 exited with an error"; rc=1; }
 wait $pid2 || { echo "robot 2 exited with an error"; rc=1; }
 grep "resumed from checkpoint" "$work/robot1.log" || { echo "robot 1 did not resume"; rc=1; }
+grep -q "resumed from checkpoint .*: snapshot [1-9]" "$work/robot1.log" ||
+  { echo "robot 1 did not resume from a snapshot"; rc=1; }
+grep "checkpoint: WARNING" "$work/robot1.log" && { echo "robot 1 set checkpoint files aside"; rc=1; }
+echo "checkpoint folder at the end: $(ls "$work/checkpoint/robot1" | tr '\n' ' ')"
 for r in 1 2; do echo "--- robot $r"; sed -n '/report:/,$p' "$work/robot$r.log"; done
 # Nothing lost: robot 1's final map starts where its mission started and holds more than it
 # had when it was killed.

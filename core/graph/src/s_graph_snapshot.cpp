@@ -617,8 +617,11 @@ std::size_t SGraph::SnapshotBytes() const {
 Expected<std::size_t> SGraph::Save(std::span<std::uint8_t> out) const {
   Impl& m = *impl_;
   if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
-  if (m.OldestBorrower() != Impl::kNoBorrower || m.full_job_pending)
-    return Error{Errc::kWouldBlock, "a job borrows from this graph"};
+  // A full solve pending would change the graph when it is applied: its snapshot would hold a
+  // state the live graph leaves. A job that only borrows the costs (the marginals) reads them
+  // on its own problem while this reads the graph's: both only read, and the graph stays.
+  if (m.full_job_pending)
+    return Error{Errc::kWouldBlock, "a full solve is pending on this graph"};
   if (out.size() < kHeaderBytes) return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
   SnapshotWriter w(out.subspan(kHeaderBytes));
   SGraphConfig config = m.config;

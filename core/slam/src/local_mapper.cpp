@@ -85,6 +85,8 @@ LocalMapper::~LocalMapper() {
 Status LocalMapper::Init(const LocalMapperConfig& config) {
   if (auto s = config.Validate(); !s) return s;
   if (full_job_.pending()) graph_.DropFullSolve(full_job_);  // it borrows the graph's costs
+  snapshot_state_ = SnapshotState::kNone;  // its buffer belongs to the state Init forgets
+  snapshot_out_ = {};
   config_ = config;
   if (auto s = graph_.Init(config.graph); !s) return s;
   if (auto s = full_job_.Init(config.graph); !s) return s;
@@ -463,6 +465,7 @@ Expected<ScanOutcome> LocalMapper::AddScanImpl(const LidarScanView& scan, StageO
   untracked_sweeps_ = 0;
   if (config_.track_scans) static_cast<void>(EnsureLocalMap());
   ++stats_.keyframes;
+  EndKeyframe();
   return ScanOutcome::kKeyframe;
 }
 

@@ -43,7 +43,29 @@ void LocalMapper::ScheduleFullSolve(bool loop) {
     keyframes_since_full_ = 0;
   }
   if (full_job_.pending() && keyframe_count_ >= full_apply_at_) ApplyBackgroundSolve();
-  if (full_wanted_ && !full_job_.pending()) BeginBackgroundSolve();
+  // The next job begins at the keyframe's end (EndKeyframe), after its rooms: a snapshot
+  // asked for can be taken between the two.
+}
+
+void LocalMapper::EndKeyframe() {
+  if (snapshot_state_ == SnapshotState::kWanted && !full_job_.pending()) {
+    snapshot_result_ = Save(snapshot_out_);
+    snapshot_state_ = SnapshotState::kTaken;
+  }
+  if (config_.full_solve_lag_keyframes > 0 && full_wanted_ && !full_job_.pending())
+    BeginBackgroundSolve();
+}
+
+void LocalMapper::RequestSnapshot(std::span<std::uint8_t> out) {
+  snapshot_out_ = out;
+  snapshot_state_ = SnapshotState::kWanted;
+}
+
+std::optional<Expected<std::size_t>> LocalMapper::TakeSnapshot() {
+  if (snapshot_state_ != SnapshotState::kTaken) return std::nullopt;
+  snapshot_state_ = SnapshotState::kNone;
+  snapshot_out_ = {};
+  return snapshot_result_;
 }
 
 void LocalMapper::BeginBackgroundSolve() {

@@ -193,6 +193,11 @@ Status LocalMapper::Load(std::span<const std::uint8_t> in) {
   prepared_ = false;
   local_map_keyframe_ = local_map_failed_ = kNoKeyframe;
   if (config_.track_scans) static_cast<void>(EnsureLocalMap());
+  snapshot_state_ = SnapshotState::kNone;
+  snapshot_out_ = {};
+  // A snapshot taken at a keyframe's end (RequestSnapshot) comes before the solve that keyframe
+  // wanted began: it begins here, as it did there.
+  if (config_.full_solve_lag_keyframes > 0 && full_wanted_) BeginBackgroundSolve();
   return Ok();
 }
 

@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
 
+#include "msgraphs/base/crc32.hpp"
 #include "msgraphs/runtime/config/key_value_file.hpp"
 
 namespace msgraphs::runtime::config {
@@ -313,6 +315,7 @@ bool ParseNodeConfig(const std::string& text,
   r.Path("checkpoint", "dir", c.checkpoint_dir);
   r.Number("checkpoint", "sync_period_s", 0.1, 3600, c.checkpoint_sync_s);
   r.Number("checkpoint", "max_speed_mps", 0.1, 20, c.relocalise_max_speed_mps);
+  r.Integer("checkpoint", "snapshot_every_keyframes", 0, 1000000, c.snapshot_every_keyframes);
 
   r.Path("output", "dir", c.output_dir);
   r.CheckAllUsed();
@@ -348,8 +351,36 @@ bool ParseNodeConfig(const std::string& text,
   if (Status s = c.link.Validate(); !s) return fail(std::string("[link] ") + s.error().detail);
   if (Status s = c.mapper.Validate(); !s) return fail(std::string("[mapping] ") + s.error().detail);
   if (Status s = c.collab.Validate(); !s) return fail(std::string("[collab] ") + s.error().detail);
+  c.mapper_settings_crc = MapperSettingsCrc(c.mapper);
   out = std::move(c);
   return true;
+}
+
+std::uint32_t MapperSettingsCrc(const core::LocalMapperConfig& m) {
+  // Every value the file's [mapping], [rooms], [odometry] noise and [lidar] T_base_lidar keys
+  // set, as the mapper holds them. The graph's own config is checked by its snapshot already.
+  std::vector<double> v;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 4; ++k) v.push_back(m.T_base_lidar.matrix()(r, k));
+  v.insert(v.end(), {m.odometry_sigma_per_m, m.odometry_sigma_min_m, m.odometry_rotation_sigma_per_m,
+                     m.odometry_rotation_sigma_min, m.odometry_gate_chi2, m.motion_seed_max_age_s,
+                     m.base_height_m, m.keyframe_spacing_m, m.keyframe_angle_rad,
+                     static_cast<double>(m.min_range_m), static_cast<double>(m.max_range_m),
+                     static_cast<double>(m.graph.max_keyframes),
+                     static_cast<double>(m.cloud_store_points),
+                     static_cast<double>(m.full_solve_lag_keyframes),
+                     static_cast<double>(m.grid.width), static_cast<double>(m.grid.height),
+                     static_cast<double>(m.grid.origin_m.x()), static_cast<double>(m.grid.origin_m.y()),
+                     m.grid_follows_robot ? 1.0 : 0.0, m.scan_match_max_fitness_m2,
+                     static_cast<double>(m.scan_match_fitness_window),
+                     m.scan_match_fitness_outlier_z, m.track_scans ? 1.0 : 0.0,
+                     static_cast<double>(m.tracking_voxel_m), m.tracking_prior_sigma_m,
+                     m.tracking_prior_sigma_rad,
+                     static_cast<double>(m.rooms.segmentation.door_cut_clearance_m),
+                     static_cast<double>(m.rooms.segmentation.close_openings_up_to_m)});
+  std::vector<std::uint8_t> bytes(v.size() * 8);
+  std::memcpy(bytes.data(), v.data(), bytes.size());
+  return Crc32(bytes);
 }
 
 bool LoadNodeConfig(const std::string& path,

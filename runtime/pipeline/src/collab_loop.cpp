@@ -102,6 +102,11 @@ void Node::Impl::CollabLoop() {
       } while (received < kMessagesPerRound && link->Receive(message, Duration()));
       PublishCollabStatus();
     }
+    // A snapshot the SLAM thread began: the session's peer state, under the session's lock.
+    if (checkpoint && checkpoint->session_wanted()) {
+      std::lock_guard<std::mutex> lock(session_mutex);
+      checkpoint->CaptureSession(session);
+    }
     // The own map the SLAM thread prepared, and peers' place requests for its next one.
     IngestExchange();
     {

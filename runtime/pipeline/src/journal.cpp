@@ -97,12 +97,28 @@ Eigen::Isometry3d GetPose(In& in) {
 
 Status IoError(const char* what) { return Error{Errc::kIo, what, errno}; }
 
+// Whether every f64 of a record's payload is finite: `bytes` all f64s (lead 0), or blocks of a
+// `lead`-byte id followed by 13 f64s (priors: plane u32, normal, d, covariance). A NaN in the
+// file is refused like a bad CRC: replay stops there, as it does at any record it cannot use.
+bool AllFinite(std::span<const std::uint8_t> bytes, std::size_t lead = 0) {
+  const std::size_t stride = lead == 0 ? 8 : lead + 104;
+  for (std::size_t at = 0; at + stride <= bytes.size(); at += stride) {
+    for (std::size_t f = at + lead; f + 8 <= at + stride; f += 8) {
+      double d;
+      std::memcpy(&d, bytes.data() + f, 8);
+      if (!std::isfinite(d)) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 Expected<JournalWriter> JournalWriter::Open(const std::string& path,
                                             std::uint16_t robot,
                                             std::uint64_t valid_bytes) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  // O_NOFOLLOW: a link planted in the checkpoint folder must not make the node write elsewhere.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd < 0) return IoError("journal: cannot open for writing").error();
   JournalWriter w(fd, 0);
   if (valid_bytes == 0) {
@@ -126,7 +142,9 @@ JournalWriter::JournalWriter(JournalWriter&& other) noexcept
     : fd_(other.fd_),
       bytes_(other.bytes_),
       records_(other.records_),
-      buffer_(std::move(other.buffer_)) {
+      messages_(other.messages_),
+      buffer_(std::move(other.buffer_)),
+      record_(std::move(other.record_)) {
   other.fd_ = -1;
 }
 
@@ -220,7 +238,14 @@ Status JournalWriter::Message(core::CollabMessageType type, std::span<const std:
   Out o(buffer_);
   o.U8(static_cast<std::uint8_t>(type));
   buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
-  return Write(JournalRecord::kMessage, buffer_);
+  Status s = Write(JournalRecord::kMessage, buffer_);
+  if (s) ++messages_;
+  return s;
+}
+
+void JournalWriter::TakeBuffersFrom(JournalWriter& other) {
+  buffer_.swap(other.buffer_);
+  record_.swap(other.record_);
 }
 
 Status JournalWriter::Sync() {
@@ -231,9 +256,13 @@ Status JournalWriter::Sync() {
 Expected<JournalReplay> ReplayJournal(const std::string& path,
                                       std::uint16_t robot,
                                       JournalSink& sink) {
-  JournalReplay r;
   std::ifstream file(path, std::ios::binary);
-  if (!file) return r;  // no journal yet: a fresh start
+  if (!file) return JournalReplay{};  // no journal yet: a fresh start
+  return ReplayJournal(file, robot, sink);
+}
+
+Expected<JournalReplay> ReplayJournal(std::istream& file, std::uint16_t robot, JournalSink& sink) {
+  JournalReplay r;
   const std::string expected = Header(robot);
   std::string header(expected.size(), '\0');
   if (!file.read(header.data(), static_cast<std::streamsize>(header.size())) ||
@@ -275,7 +304,7 @@ Expected<JournalReplay> ReplayJournal(const std::string& path,
     bool ok = true;
     switch (type) {
       case JournalRecord::kOdometry: {
-        if (!(ok = length == 64)) break;
+        if (!(ok = length == 64 && AllFinite(payload))) break;
         const double t = in.F64();
         sink.OnOdometry(t, GetPose(in));
         r.last_odometry_s = t;
@@ -286,7 +315,9 @@ Expected<JournalReplay> ReplayJournal(const std::string& path,
         if (!(ok = in.Has(20))) break;
         const double start = in.F64(), end = in.F64();
         const std::uint32_t n = in.U32();
-        if (!(ok = in.Rest().size() == static_cast<std::size_t>(n) * 8)) break;
+        if (!(ok = in.Rest().size() == static_cast<std::size_t>(n) * 8 && std::isfinite(start) &&
+                   std::isfinite(end) && start <= end))
+          break;
         points.resize(n);
         times.resize(n);
         for (std::uint32_t i = 0; i < n; ++i) {
@@ -302,7 +333,9 @@ Expected<JournalReplay> ReplayJournal(const std::string& path,
       case JournalRecord::kPriors: {
         if (!(ok = in.Has(4))) break;
         const std::uint32_t n = in.U32();
-        if (!(ok = in.Rest().size() == static_cast<std::size_t>(n) * 108)) break;
+        if (!(ok = in.Rest().size() == static_cast<std::size_t>(n) * 108 &&
+                   AllFinite(in.Rest(), 4)))
+          break;
         priors.resize(n);
         for (core::PlanePrior& p : priors) {
           p.plane = in.U32();
@@ -327,7 +360,7 @@ Expected<JournalReplay> ReplayJournal(const std::string& path,
         break;
       }
       case JournalRecord::kMotion: {
-        if (!(ok = length == 65)) break;
+        if (!(ok = length == 65 && AllFinite(std::span(payload).first(64)))) break;
         const double end = in.F64();
         const Eigen::Isometry3d T = GetPose(in);
         const std::uint8_t tracked = in.U8();
@@ -340,7 +373,7 @@ Expected<JournalReplay> ReplayJournal(const std::string& path,
         ok = false;
     }
     if (!ok) {
-      r.stopped = "record of unknown type or wrong size";
+      r.stopped = "record of unknown type, wrong size or numbers that are not finite";
       break;
     }
     ++r.records;

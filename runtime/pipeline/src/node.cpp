@@ -3,7 +3,6 @@
 // conditions, on the caller's thread.
 #include <cinttypes>
 #include <cstdio>
-#include <filesystem>
 
 #include "msgraphs/drivers/gpio/gpio.hpp"
 #include "msgraphs/platform/clock.hpp"
@@ -23,56 +22,10 @@ const char* PaceName(const config::NodeConfig& c) {
   return c.pace == config::Pace::kLockstep ? "recorded, lock-step" : "recorded pace";
 }
 
-// Discards what the session would send while it is rebuilt from the journal.
+// Discards what the session would send while it decides on the restored evidence.
 class NullOutbox final : public core::CollabOutbox {
  public:
   void Send(core::CollabMessageType, std::uint16_t, std::span<const std::uint8_t>) override {}
-};
-
-// Rebuilds the mapper and the session from the checkpoint journal.
-class Restore final : public JournalSink {
- public:
-  Restore(core::LocalMapper& mapper, core::CollabSession& session)
-      : mapper_(mapper), session_(session) {}
-  void OnOdometry(double stamp_s, const Eigen::Isometry3d& T) override {
-    static_cast<void>(mapper_.AddOdometry(stamp_s, T));
-    last_odometry = T;
-  }
-  void OnScan(std::span<const Eigen::Vector3f> points,
-              std::span<const float> times,
-              double start_s,
-              double end_s) override {
-    // A keyframe made as it was live (its tracked motion), or, from a journal written before
-    // scan tracking, through AddScan.
-    if (have_motion_ && motion_end_s_ == end_s) {
-      static_cast<void>(mapper_.ReplayKeyframe({points, times, start_s, end_s}, motion_));
-    } else {
-      static_cast<void>(mapper_.AddScan({points, times, start_s, end_s}));
-    }
-    have_motion_ = false;
-  }
-  void OnMotion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked) override {
-    motion_.T_last_new = T_last_new;
-    motion_.tracked = tracked;
-    motion_end_s_ = end_s;
-    have_motion_ = true;
-  }
-  void OnPriors(std::span<const core::PlanePrior> priors) override {
-    static_cast<void>(mapper_.SetPlanePriors(priors));
-  }
-  void OnFinish() override { static_cast<void>(mapper_.Finish()); }
-  void OnMessage(core::CollabMessageType type, std::span<const std::uint8_t> bytes) override {
-    static_cast<void>(session_.Receive(type, bytes, outbox_));
-  }
-  Eigen::Isometry3d last_odometry = Eigen::Isometry3d::Identity();  ///< odometry frame, newest
-
- private:
-  core::LocalMapper& mapper_;
-  core::CollabSession& session_;
-  NullOutbox outbox_;
-  core::LocalMapper::KeyframeMotion motion_;
-  double motion_end_s_ = 0;
-  bool have_motion_ = false;
 };
 
 }  // namespace
@@ -85,6 +38,7 @@ Node::~Node() {
   impl_->scans.Close();
   impl_->odometry.Close();
   impl_->wake_slam.notify_all();
+  if (impl_->checkpoint) impl_->checkpoint->Wake();
   for (std::thread& t : impl_->threads)
     if (t.joinable()) t.join();
 }
@@ -134,41 +88,48 @@ std::unique_ptr<Node> Node::Create(const config::NodeConfig& config,
     m.replay_clock = std::make_unique<ReplayClock>(config.speed);
 
   if (!config.checkpoint_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(config.checkpoint_dir, ec);
-    const std::string path =
-        (std::filesystem::path(config.checkpoint_dir) / "journal.bin").string();
-    const SteadyTime t0 = platform::SteadyNow();
-    Restore restore(m.mapper, m.session);
-    auto replay = ReplayJournal(path, config.robot.value, restore);
-    if (!replay) return fail("checkpoint", replay.error());
-    if (replay->records > 0) {
+    CheckpointSettings settings;
+    settings.dir = config.checkpoint_dir;
+    settings.robot = config.robot.value;
+    settings.mapper_settings_crc = config.mapper_settings_crc;
+    settings.snapshot_every_keyframes = config.snapshot_every_keyframes;
+    CheckpointRestore restored;
+    auto checkpoint = Checkpoint::Open(settings, m.mapper, m.session, restored);
+    if (!checkpoint) return fail("checkpoint", checkpoint.error());
+    m.checkpoint = std::move(*checkpoint);
+    for (const std::string& why : restored.set_aside)
+      std::printf("checkpoint: WARNING: set aside %s\n", why.c_str());
+    if (restored.anything()) {
       NullOutbox discard;
       m.session.Match(discard);
+      const JournalReplay& r = restored.replayed;
       std::printf(
-          "resumed from checkpoint %s: %llu keyframes, %llu odometry samples, %llu peer messages, "
-          "%llu prior updates in %.1f s%s%s\n",
-          path.c_str(), static_cast<unsigned long long>(replay->scans),
-          static_cast<unsigned long long>(replay->odometry),
-          static_cast<unsigned long long>(replay->messages),
-          static_cast<unsigned long long>(replay->priors), (platform::SteadyNow() - t0).seconds(),
-          replay->stopped.empty() ? "" : "; stopped early: ", replay->stopped.c_str());
-      m.resume_scans_after_s = replay->last_scan_end_s;
-      m.resume_odometry_after_s = replay->last_odometry_s;
+          "resumed from checkpoint %s: %s%llu keyframes, %llu odometry samples, %llu peer messages, "
+          "%llu prior updates replayed from %zu journal(s) in %.1f s (snapshot loaded in %.1f s)%s%s\n",
+          config.checkpoint_dir.c_str(),
+          restored.from_snapshot
+              ? ("snapshot " + std::to_string(restored.snapshot_generation) + " (" +
+                 std::to_string(m.mapper.stats().keyframes - r.scans) + " keyframes, " +
+                 std::to_string(restored.session_messages) + " peer messages) + ")
+                    .c_str()
+              : "",
+          static_cast<unsigned long long>(r.scans), static_cast<unsigned long long>(r.odometry),
+          static_cast<unsigned long long>(r.messages), static_cast<unsigned long long>(r.priors),
+          restored.journals, restored.replay_s, restored.load_s,
+          r.stopped.empty() ? "" : "; stopped early: ", r.stopped.c_str());
+      m.resume_scans_after_s = restored.last_scan_end_s;
+      m.resume_odometry_after_s = restored.last_odometry_s;
       // Live odometry restarts its integration at identity, and the robot may have walked on
       // while the node was down: the SLAM thread relocalises the first scan against the map.
       if (config.odometry_source != config::OdometrySource::kCandump) {
         m.reanchor_odometry = true;
-        m.T_old_last = restore.last_odometry;
-        m.old_last_stamp_s = replay->last_odometry_s;
+        m.T_old_last = restored.T_odom_last;
+        m.old_last_stamp_s = restored.last_odometry_s;
         m.new_odometry.Init(config.mapper.odometry_capacity, config.mapper.odometry_max_gap_s);
       }
       std::lock_guard<std::mutex> lock(m.status_mutex);
       m.slam_status.keyframes = m.mapper.stats().keyframes;
     }
-    auto writer = JournalWriter::Open(path, config.robot.value, replay->valid_bytes);
-    if (!writer) return fail("checkpoint", writer.error());
-    m.journal.emplace(std::move(*writer));
   }
 
   auto link = link::FleetLink::Create(config.robot, config.link);
@@ -325,6 +286,8 @@ int Node::Run(const std::atomic<bool>& stop) {
   m.threads.emplace_back([&m] { m.CollabLoop(); });
   m.threads.emplace_back([&m] { m.solver.Loop([&m] { return m.ShouldStop(); }); });
   m.threads.emplace_back([&m] { m.marginals_solver.Loop([&m] { return m.ShouldStop(); }); });
+  if (m.checkpoint)
+    m.threads.emplace_back([&m] { m.checkpoint->RunWriter([&m] { return m.ShouldStop(); }); });
 
   int exit_code = 0;
   const Duration telemetry_period = Duration::FromSeconds(1.0 / c.telemetry_hz);

@@ -24,7 +24,7 @@
 #include "msgraphs/runtime/link/ros_publisher.hpp"
 #include "msgraphs/runtime/pipeline/bounded_queue.hpp"
 #include "msgraphs/runtime/pipeline/handover.hpp"
-#include "msgraphs/runtime/pipeline/journal.hpp"
+#include "msgraphs/runtime/pipeline/checkpoint.hpp"
 #include "msgraphs/runtime/pipeline/latency_window.hpp"
 #include "msgraphs/runtime/pipeline/node.hpp"
 #include "msgraphs/runtime/pipeline/replay_clock.hpp"
@@ -194,10 +194,9 @@ struct Node::Impl {
   std::unique_ptr<drivers::gpio::DigitalOutput> led_line;
   std::unique_ptr<drivers::gpio::StatusLed> led;
 
-  // Checkpoint (optional): the journal, shared by the SLAM and collab threads.
-  std::mutex journal_mutex;
-  std::optional<JournalWriter> journal;
-  std::atomic<std::uint64_t> journal_errors{0};
+  // Checkpoint (optional): the journal in generations, shared by the SLAM and collab threads,
+  // and its writer thread's snapshots.
+  std::unique_ptr<Checkpoint> checkpoint;
   /// Restored from the journal: recorded inputs skip what is already in the map.
   double resume_scans_after_s = -1, resume_odometry_after_s = -1;
   /// Live inputs after a resume: the odometry integration began again at identity, and the
@@ -216,9 +215,7 @@ struct Node::Impl {
   /// Maps the held new odometry into the mapper (and the journal) through T_odom_fix.
   void ReleaseNewOdometry();
   void Journal(auto&& write) {
-    if (!journal) return;
-    std::lock_guard<std::mutex> lock(journal_mutex);
-    if (!write(*journal)) journal_errors.fetch_add(1, std::memory_order_relaxed);
+    if (checkpoint) checkpoint->Journal(write);
   }
 
   std::vector<std::thread> threads;

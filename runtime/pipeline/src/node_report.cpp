@@ -233,12 +233,16 @@ void Node::Impl::PrintReport() {
           store.stored_clouds(), static_cast<double>(store.used_points()) / 1e6,
           static_cast<double>(store.capacity_points()) / 1e6, mapper.cloud_cover().cell_m(),
           store_stats.evicted_covered, store_stats.evicted_gone, store_stats.evicted_uncovered);
-  if (journal) {
-    std::lock_guard<std::mutex> lock(journal_mutex);
+  if (checkpoint) {
+    const CheckpointStats cs = checkpoint->stats();
     Appendf(text,
-            "  checkpoint journal: %" PRIu64 " records written this run, %.1f MB in all, %" PRIu64
-            " write errors\n",
-            journal->records(), static_cast<double>(journal->bytes()) / 1e6, journal_errors.load());
+            "  checkpoint: generation %" PRIu64 " (newest durable snapshot %" PRIu64 "), %" PRIu64
+            " snapshots written this run (last %.1f MB in %.2f s), %" PRIu64 " failed%s%s, %" PRIu64
+            " files removed, %" PRIu64 " journal write errors\n",
+            cs.generation, cs.durable_generation, cs.snapshots_written,
+            static_cast<double>(cs.last_snapshot_bytes) / 1e6, cs.last_write_s, cs.snapshot_failures,
+            cs.last_failure.empty() ? "" : ": ", cs.last_failure.c_str(), cs.files_removed,
+            cs.journal_errors);
   }
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);

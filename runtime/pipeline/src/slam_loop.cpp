@@ -263,6 +263,9 @@ void Node::Impl::SlamLoop() {
                static_cast<bool>(j.Scan(view.points_lidar, view.time_offset_s, view.start_s,
                                         view.end_s, config.mapper.max_range_m));
       });
+      // After the keyframe's records: a snapshot the mapper took at its end begins the next
+      // generation's journal here.
+      if (checkpoint) checkpoint->AfterKeyframe(mapper, view.end_s);
       if (unpublished_keyframes.size() < unpublished_keyframes.capacity())
         unpublished_keyframes.push_back(scan->last_packet);
     }
@@ -276,7 +279,7 @@ void Node::Impl::SlamLoop() {
       slam_status.keyframe_p50_ms = keyframe_ms.Percentile(0.5);
       slam_status.keyframe_p99_ms = keyframe_ms.Percentile(0.99);
     }
-    if (journal && platform::SteadyNow() >= next_sync) {
+    if (checkpoint && platform::SteadyNow() >= next_sync) {
       Journal([](JournalWriter& j) { return static_cast<bool>(j.Sync()); });
       next_sync = platform::SteadyNow() + Duration::FromSeconds(config.checkpoint_sync_s);
     }

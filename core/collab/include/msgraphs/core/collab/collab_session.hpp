@@ -256,6 +256,12 @@ struct MergeLogEntry {
   std::size_t set_aside = 0, places = 0;  ///< transforms set aside by place evidence, clouds weighed
 };
 
+/// What CollabSession::ExportReceived wrote.
+struct CollabExportStats {
+  std::size_t messages = 0, bytes = 0;
+  std::size_t failed = 0;  ///< parts that did not encode (not exported: they come again live)
+};
+
 class CollabSession {
  public:
   CollabSession();
@@ -284,6 +290,14 @@ class CollabSession {
 
   /// A message from the link. Malformed ones return the decoder's error and are counted.
   Status Receive(CollabMessageType type, std::span<const std::uint8_t> bytes, CollabOutbox& out);
+
+  /// What the session holds of its peers, as messages into `out` (to 0) that Receive files
+  /// back into a new session alike: each peer's distilled graph whole, its room descriptors,
+  /// its newest free-space summary (the parts the runtime checkpoint's journal keeps; room and
+  /// place clouds are asked for again when needed). Matches and merges are not exported: Match
+  /// decides them again from this evidence, as after a journal replay. The peers' message
+  /// counters restart. Allocates nothing (encodes into the session's message buffer).
+  CollabExportStats ExportReceived(CollabOutbox& out);
 
   /// Proposes, aligns, decides and solves; returns true when a room match was added. `now_s`
   /// (any clock of the caller's) stamps the decisions it logs.

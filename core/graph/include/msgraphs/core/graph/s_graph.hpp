@@ -294,7 +294,8 @@ class SGraph {
   /// Writes the whole graph (every record in its slot, the free lists in their order, the held
   /// sums, the counters, each factor's measurement) into `out`; returns the bytes written.
   /// Loaded into a graph initialised with the same config, it goes on bit for bit as this one
-  /// would. kWouldBlock while a job borrows from the graph; kCapacityExceeded when `out` is too
+  /// would. kWouldBlock while a full solve is pending (a job that only borrows the costs, such
+  /// as the marginals, does not stop it: both only read); kCapacityExceeded when `out` is too
   /// small (SnapshotBytes always suffices). Allocates nothing.
   Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
   /// Replaces this graph by a snapshot. kInvalidArgument, with the graph unchanged, for bytes

@@ -27,6 +27,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -356,6 +357,17 @@ class LocalMapper {
   /// config; one whose parts do not fit this mapper's stores or do not hold together leaves it
   /// as Init left it. Allocates (the graph's Ceres problem).
   Status Load(std::span<const std::uint8_t> in);
+  /// Asks for a snapshot (Save) into `out` at the end of the next keyframe that has no full
+  /// solve pending: after the solve due at that keyframe is applied and before the next one
+  /// begins, so the state it holds is whole. Saving between scans instead would almost never
+  /// find that moment with full_solve_lag_keyframes > 0 (a solve is pending for most
+  /// keyframes). `out` must stay valid until the result is taken; SnapshotBytes() suffices. A
+  /// new request replaces one not yet served; Init and Load forget it. Allocates nothing.
+  void RequestSnapshot(std::span<std::uint8_t> out);
+  /// The snapshot taken for the last request (its size in `out`, or why Save refused), once;
+  /// nothing while it still waits for its keyframe.
+  std::optional<Expected<std::size_t>> TakeSnapshot();
+  bool snapshot_requested() const { return snapshot_state_ == SnapshotState::kWanted; }
 
   /// The background full solve when one is begun and nobody has run it yet, for a worker
   /// thread to take (TryClaim, then Run); nullptr otherwise. The mapper must outlive the worker's
@@ -441,6 +453,8 @@ class LocalMapper {
   void ScheduleFullSolve(bool loop);
   void ApplyBackgroundSolve();
   void BeginBackgroundSolve();
+  /// The keyframe's last step: a snapshot asked for, then the background solve wanted.
+  void EndKeyframe();
   template <class Archive>
   void Io(Archive& ar);  // the snapshot's own fields (local_mapper_snapshot.cpp)
 
@@ -509,6 +523,11 @@ class LocalMapper {
   std::uint64_t keyframe_count_ = 0, full_apply_at_ = 0;
   bool full_wanted_ = false;
   BoundedVector<std::uint32_t> pending_loops_, job_loops_;
+  // The snapshot asked for (RequestSnapshot): its buffer and, once taken, its result.
+  enum class SnapshotState : std::uint8_t { kNone, kWanted, kTaken };
+  SnapshotState snapshot_state_ = SnapshotState::kNone;
+  std::span<std::uint8_t> snapshot_out_;
+  Expected<std::size_t> snapshot_result_ = std::size_t{0};
   LocalMapperStats stats_;
 };
 

@@ -94,6 +94,13 @@ struct NodeConfig {
   // [checkpoint]
   std::string checkpoint_dir;      ///< empty: no checkpoint; else the journal lives here
   double checkpoint_sync_s = 5.0;  ///< fsync period (power-cut safety)
+  /// A snapshot (and a new journal) every this many keyframes: the journal is compacted, and a
+  /// restart loads the snapshot and replays the keyframes since (docs/runtime.md). 0: the
+  /// journal only, replayed whole at a restart.
+  std::size_t snapshot_every_keyframes = 100;
+  /// CRC-32 of what shapes the map that the config file sets ([mapping], [rooms], the odometry
+  /// noise, T_base_lidar): a snapshot made under other values is not loaded (derived, not read).
+  std::uint32_t mapper_settings_crc = 0;
   /// The robot's top speed: after a restart, how far it can have walked while the node was
   /// down (the relocalisation's reach). Spot's is 1.6 m/s.
   double relocalise_max_speed_mps = 1.6;
@@ -101,6 +108,9 @@ struct NodeConfig {
   // [output]
   std::string output_dir;  ///< empty: no files at exit
 };
+
+/// The CRC-32 of the mapper settings a config file can set (NodeConfig::mapper_settings_crc).
+std::uint32_t MapperSettingsCrc(const core::LocalMapperConfig& mapper);
 
 /// Reads and validates. On failure returns false with a message naming file and line.
 /// `overrides` are "section.key=value" strings applied over the file (command line --set).

@@ -31,6 +31,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <istream>
 #include <span>
 #include <string>
 #include <vector>
@@ -76,12 +77,17 @@ class JournalWriter {
   Status Sync();
   std::uint64_t bytes() const { return bytes_; }
   std::uint64_t records() const { return records_; }
+  /// kMessage records written through this writer.
+  std::uint64_t messages() const { return messages_; }
+  /// Swaps the record buffers with `other` (grown to the largest scan): a journal that
+  /// replaces another at a checkpoint generation does not grow its own again.
+  void TakeBuffersFrom(JournalWriter& other);
 
  private:
   explicit JournalWriter(int fd, std::uint64_t bytes) : fd_(fd), bytes_(bytes) {}
   Status Write(JournalRecord type, std::span<const std::uint8_t> payload);
   int fd_ = -1;
-  std::uint64_t bytes_ = 0, records_ = 0;
+  std::uint64_t bytes_ = 0, records_ = 0, messages_ = 0;
   std::vector<std::uint8_t> buffer_, record_;  // grow to the largest scan once, then reused
 };
 
@@ -114,5 +120,8 @@ class JournalSink {
 Expected<JournalReplay> ReplayJournal(const std::string& path,
                                       std::uint16_t robot,
                                       JournalSink& sink);
+/// The same from a stream (the fuzz target's bytes). A record whose numbers are not finite is
+/// where replay stops, as at a bad CRC.
+Expected<JournalReplay> ReplayJournal(std::istream& in, std::uint16_t robot, JournalSink& sink);
 
 }  // namespace msgraphs::runtime

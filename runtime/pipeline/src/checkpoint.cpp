@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: MIT
+// Checkpoint::Open: the restart (checkpoint.hpp). The folder's generations are found, the newest
+// snapshot that checks is loaded, and the journals from its generation on are replayed.
+#include "msgraphs/runtime/pipeline/checkpoint.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <filesystem>
+#include <map>
+
+#include "checkpoint_folder.hpp"
+
+namespace msgraphs::runtime {
+
+namespace {
+
+// Discards what the session would send while it is rebuilt.
+class NullOutbox final : public core::CollabOutbox {
+ public:
+  void Send(core::CollabMessageType, std::uint16_t, std::span<const std::uint8_t>) override {}
+};
+
+// Rebuilds the mapper and the session from a journal.
+class Restore final : public JournalSink {
+ public:
+  Restore(core::LocalMapper& mapper, core::CollabSession& session)
+      : mapper_(mapper), session_(session) {}
+  void OnOdometry(double stamp_s, const Eigen::Isometry3d& T) override {
+    static_cast<void>(mapper_.AddOdometry(stamp_s, T));
+    last_odometry = T;
+  }
+  void OnScan(std::span<const Eigen::Vector3f> points,
+              std::span<const float> times,
+              double start_s,
+              double end_s) override {
+    // A keyframe made as it was live (its tracked motion), or, from a journal written before
+    // scan tracking, through AddScan.
+    if (have_motion_ && motion_end_s_ == end_s) {
+      static_cast<void>(mapper_.ReplayKeyframe({points, times, start_s, end_s}, motion_));
+    } else {
+      static_cast<void>(mapper_.AddScan({points, times, start_s, end_s}));
+    }
+    have_motion_ = false;
+  }
+  void OnMotion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked) override {
+    motion_.T_last_new = T_last_new;
+    motion_.tracked = tracked;
+    motion_end_s_ = end_s;
+    have_motion_ = true;
+  }
+  void OnPriors(std::span<const core::PlanePrior> priors) override {
+    static_cast<void>(mapper_.SetPlanePriors(priors));
+  }
+  void OnFinish() override { static_cast<void>(mapper_.Finish()); }
+  void OnMessage(core::CollabMessageType type, std::span<const std::uint8_t> bytes) override {
+    // The snapshot's session part holds the first messages of its generation's journal.
+    if (skip_messages > 0) {
+      --skip_messages;
+      return;
+    }
+    static_cast<void>(session_.Receive(type, bytes, outbox_));
+  }
+  Eigen::Isometry3d last_odometry = Eigen::Isometry3d::Identity();  ///< odometry frame, newest
+  std::uint64_t skip_messages = 0;
+
+ private:
+  core::LocalMapper& mapper_;
+  core::CollabSession& session_;
+  NullOutbox outbox_;
+  core::LocalMapper::KeyframeMotion motion_;
+  double motion_end_s_ = 0;
+  bool have_motion_ = false;
+};
+
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void Add(JournalReplay& sum, const JournalReplay& r) {
+  sum.records += r.records;
+  sum.odometry += r.odometry;
+  sum.scans += r.scans;
+  sum.priors += r.priors;
+  sum.finishes += r.finishes;
+  sum.messages += r.messages;
+  sum.motions += r.motions;
+  if (r.last_scan_end_s >= 0) sum.last_scan_end_s = r.last_scan_end_s;
+  if (r.last_odometry_s >= 0) sum.last_odometry_s = r.last_odometry_s;
+  if (!r.stopped.empty()) sum.stopped = r.stopped;
+}
+
+}  // namespace
+
+Checkpoint::~Checkpoint() = default;
+
+std::string Checkpoint::PathOf(bool snapshot, std::uint64_t generation) const {
+  return CheckpointPath(settings_.dir, snapshot, generation);
+}
+
+Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings& settings,
+                                                       core::LocalMapper& mapper,
+                                                       core::CollabSession& session,
+                                                       CheckpointRestore& restored) {
+  restored = CheckpointRestore{};
+  std::unique_ptr<Checkpoint> c(new Checkpoint());
+  c->settings_ = settings;
+  std::error_code ec;
+  std::filesystem::create_directories(settings.dir, ec);
+  auto folder = ListCheckpointFolder(settings.dir);
+  if (!folder) return folder.error();
+  const auto set_aside = [&](const std::string& path, const std::string& why) {
+    const std::string to = SetAside(path);
+    restored.set_aside.push_back(path + " -> " + to + ": " + why);
+  };
+
+  // The newest snapshot that checks.
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<CheckpointMeta> base;
+  std::vector<std::uint8_t> bytes;
+  for (auto it = folder->snapshots.rbegin(); it != folder->snapshots.rend() && !base; ++it) {
+    const std::uint64_t g = *it;
+    const std::string path = c->PathOf(true, g);
+    const std::size_t cap = kCheckpointHeadBytes + mapper.SnapshotBytes() + (256u << 20);
+    if (Status s = ReadWholeFile(path, cap, bytes); !s) {
+      set_aside(path, s.error().detail);
+      continue;
+    }
+    auto parsed = ParseCheckpoint(bytes, settings.robot);
+    if (!parsed) {
+      if (parsed.error().code == Errc::kInvalidConfig) return parsed.error();
+      set_aside(path, parsed.error().detail);
+      continue;
+    }
+    if (parsed->meta.generation != g) {
+      set_aside(path, "its generation is not its name's");
+      continue;
+    }
+    if (parsed->meta.mapper_settings_crc != settings.mapper_settings_crc) {
+      set_aside(path, "made under other mapper settings");
+      continue;
+    }
+    if (Status s = mapper.Load(parsed->mapper); !s) {
+      set_aside(path, s.error().detail);
+      continue;
+    }
+    NullOutbox discard;
+    ForEachSessionMessage(*parsed, [&](core::CollabMessageType type, std::span<const std::uint8_t> m) {
+      static_cast<void>(session.Receive(type, m, discard));
+      ++restored.session_messages;
+    });
+    base = parsed->meta;
+  }
+  bytes = {};
+  restored.load_s = SecondsSince(t0);
+
+  Restore sink(mapper, session);
+  std::uint64_t first = 0;
+  if (base) {
+    restored.from_snapshot = true;
+    restored.snapshot_generation = base->generation;
+    restored.last_scan_end_s = base->last_scan_end_s;
+    restored.last_odometry_s = base->last_odometry_s;
+    sink.last_odometry = base->T_odom_last;
+    sink.skip_messages = base->journal_messages;
+    c->durable_ = first = base->generation;
+  } else if (!folder->journals.empty() && folder->journals.front() != 0) {
+    // No snapshot to continue, and journal.bin, where the journals begin, was removed after two
+    // snapshots that are gone now: nothing to rebuild from. Start empty, the evidence kept aside.
+    for (std::uint64_t j : folder->journals)
+      set_aside(c->PathOf(false, j), "no snapshot to continue and no journal.bin to begin");
+    folder->journals.clear();
+  }
+
+  // The journals from `first` on, each continuing the last: one that ended early or a gap ends
+  // the chain, and what follows is set aside (never replayed over a hole).
+  const auto t1 = std::chrono::steady_clock::now();
+  c->generation_ = first;
+  std::uint64_t append_at = 0;
+  bool chain_ended = false;
+  for (std::uint64_t j : folder->journals) {
+    if (j < first) continue;
+    const std::string path = c->PathOf(false, j);
+    if (chain_ended || j != c->generation_ + (restored.journals == 0 ? 0 : 1)) {
+      chain_ended = true;
+      set_aside(path, "after a journal that ended early or is missing");
+      continue;
+    }
+    auto r = ReplayJournal(path, settings.robot, sink);
+    if (!r) return r.error();
+    if (j == first) sink.skip_messages = 0;  // only the snapshot's own generation had them
+    Add(restored.replayed, *r);
+    ++restored.journals;
+    c->generation_ = j;
+    append_at = r->valid_bytes;
+    chain_ended = !r->stopped.empty();
+  }
+  restored.replay_s = SecondsSince(t1);
+  if (restored.replayed.last_scan_end_s >= 0) restored.last_scan_end_s = restored.replayed.last_scan_end_s;
+  if (restored.replayed.last_odometry_s >= 0) restored.last_odometry_s = restored.replayed.last_odometry_s;
+  restored.T_odom_last = sink.last_odometry;
+  // Snapshots older than the one loaded stay until the next is durable (RemoveBelow).
+
+  // Append to the newest journal of the chain (where its good records end).
+  auto writer = JournalWriter::Open(c->PathOf(false, c->generation_), settings.robot, append_at);
+  if (!writer) return writer.error();
+  c->journal_.emplace(std::move(*writer));
+  if (settings.snapshot_every_keyframes > 0) {
+    c->file_bytes_ = kCheckpointHeadBytes + mapper.SnapshotBytes();
+    c->file_.assign(c->file_bytes_, 0);
+  }
+  c->stats_.generation = c->generation_;
+  c->stats_.durable_generation = c->durable_;
+  return c;
+}
+
+CheckpointStats Checkpoint::stats() const {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  CheckpointStats s = stats_;
+  s.journal_errors = journal_errors_.load(std::memory_order_relaxed);
+  return s;
+}
+
+}  // namespace msgraphs::runtime

@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: MIT
+// Checkpoint's generations while the node runs (checkpoint.hpp): the SLAM thread switches the
+// journal at the mapper's snapshot, the collab thread adds the session, the writer thread makes
+// it durable and removes what the previous durable snapshot made redundant.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "checkpoint_folder.hpp"
+#include "msgraphs/base/byte_order.hpp"
+#include "msgraphs/base/crc32.hpp"
+#include "msgraphs/runtime/pipeline/checkpoint.hpp"
+
+namespace msgraphs::runtime {
+
+namespace {
+
+// Appends each exported message to the snapshot's session part.
+class SessionPart final : public core::CollabOutbox {
+ public:
+  SessionPart(std::vector<std::uint8_t>& out, std::uint32_t& count) : out_(out), count_(count) {}
+  void Send(core::CollabMessageType type, std::uint16_t, std::span<const std::uint8_t> bytes) override {
+    AppendSessionMessage(type, bytes, out_);
+    ++count_;
+  }
+
+ private:
+  std::vector<std::uint8_t>& out_;
+  std::uint32_t& count_;
+};
+
+}  // namespace
+
+void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
+  if (settings_.snapshot_every_keyframes == 0) return;
+  ++keyframes_since_;
+  if (!requested_) {
+    // One snapshot at a time: the next is asked for once the writer is done with the last.
+    if (keyframes_since_ < settings_.snapshot_every_keyframes ||
+        state_.load(std::memory_order_acquire) != State::kIdle)
+      return;
+    mapper.RequestSnapshot(std::span(file_).subspan(kCheckpointHeadBytes));
+    requested_ = true;
+    // The mapper may take it at this very keyframe's end only if asked before it: it is asked
+    // now, for the next keyframe with no solve pending.
+    return;
+  }
+  auto taken = mapper.TakeSnapshot();
+  if (!taken) return;  // a solve was pending at this keyframe's end
+  requested_ = false;
+  keyframes_since_ = 0;
+  if (!*taken) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.snapshot_failures;
+    stats_.last_failure = taken->error().detail;
+    return;
+  }
+  // The snapshot holds this keyframe, whose records went to the journal just before this call:
+  // the next generation's journal begins after them.
+  const std::uint64_t next = generation_ + 1;
+  auto writer = JournalWriter::Open(PathOf(false, next), settings_.robot, 0);
+  if (!writer) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.snapshot_failures;
+    stats_.last_failure = writer.error().detail;
+    return;
+  }
+  meta_ = CheckpointMeta{};
+  meta_.robot = settings_.robot;
+  meta_.generation = next;
+  meta_.mapper_settings_crc = settings_.mapper_settings_crc;
+  meta_.last_scan_end_s = scan_end_s;
+  const core::OdometryBuffer& odometry = mapper.odometry();
+  if (odometry.size() > 0) {
+    meta_.last_odometry_s = odometry.stamp(odometry.size() - 1);
+    meta_.T_odom_last = odometry.pose(odometry.size() - 1);
+  }
+  mapper_bytes_ = **taken;
+  {
+    std::lock_guard<std::mutex> lock(journal_mutex_);
+    writer->TakeBuffersFrom(*journal_);
+    closed_journal_.emplace(std::move(*journal_));
+    journal_.emplace(std::move(*writer));
+    generation_ = next;
+  }
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.generation = next;
+  }
+  state_.store(State::kSession, std::memory_order_release);
+}
+
+void Checkpoint::CaptureSession(core::CollabSession& session) {
+  if (state_.load(std::memory_order_acquire) != State::kSession) return;
+  session_.clear();
+  session_count_ = 0;
+  SessionPart part(session_, session_count_);
+  static_cast<void>(session.ExportReceived(part));
+  {
+    // Every peer message journaled since the switch was received by the session before this
+    // (both happen under the session's lock): the export holds them; replay skips them.
+    std::lock_guard<std::mutex> lock(journal_mutex_);
+    meta_.journal_messages = journal_->messages();
+  }
+  state_.store(State::kWrite, std::memory_order_release);
+  Wake();
+}
+
+void Checkpoint::Wake() {
+  std::lock_guard<std::mutex> lock(wake_mutex_);
+  wake_.notify_all();
+}
+
+void Checkpoint::RunWriter(const std::function<bool()>& stop) {
+  for (;;) {
+    {
+      std::unique_lock<std::mutex> lock(wake_mutex_);
+      wake_.wait_for(lock, std::chrono::milliseconds(200), [&] {
+        return stop() || state_.load(std::memory_order_acquire) == State::kWrite;
+      });
+    }
+    if (state_.load(std::memory_order_acquire) == State::kWrite) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const Status s = WriteSnapshot();
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      if (s) {
+        ++stats_.snapshots_written;
+        stats_.durable_generation = durable_;
+        stats_.last_write_s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      } else {
+        ++stats_.snapshot_failures;
+        stats_.last_failure = s.error().detail;
+      }
+      state_.store(State::kIdle, std::memory_order_release);
+    }
+    if (stop()) return;
+  }
+}
+
+Status Checkpoint::WriteSnapshot() {
+  // The journal the switch closed: complete on disk before anything relies on the new one.
+  if (closed_journal_) {
+    const Status synced = closed_journal_->Sync();
+    closed_journal_.reset();
+    if (!synced) return synced;
+  }
+  // The new journal's name: a snapshot never exists without its journal's entry.
+  if (Status s = SyncFolder(settings_.dir); !s) return s;
+  const std::size_t session_at = kCheckpointHeadBytes + mapper_bytes_;
+  file_.resize(session_at + 4 + session_.size() + 4);
+  WriteCheckpointHead(meta_, mapper_bytes_,
+                      std::span<std::uint8_t, kCheckpointHeadBytes>(file_.data(), kCheckpointHeadBytes));
+  WriteU32Le(file_.data() + session_at, session_count_);
+  std::copy(session_.begin(), session_.end(), file_.begin() + static_cast<std::ptrdiff_t>(session_at + 4));
+  const std::span<const std::uint8_t> body(file_.data(), file_.size() - 4);
+  WriteU32Le(file_.data() + body.size(), Crc32(body));
+  const Status written = WriteFileDurably(settings_.dir, PathOf(true, meta_.generation), file_);
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.last_snapshot_bytes = file_.size();
+  }
+  // Back to the head and the mapper's room for the next request (capacity kept).
+  file_.resize(file_bytes_);
+  if (!written) return written;
+  const std::uint64_t previous = durable_;
+  durable_ = meta_.generation;
+  // What the previous durable snapshot made redundant: everything below it. The previous one
+  // and its journals stay as the fallback should the new one not check at the next start.
+  if (previous > 0) RemoveBelow(previous);
+  return Ok();
+}
+
+void Checkpoint::RemoveBelow(std::uint64_t generation) {
+  auto folder = ListCheckpointFolder(settings_.dir);
+  if (!folder) return;
+  std::uint64_t removed = 0;
+  // Snapshots first: a journal is never gone while a snapshot that needs it is there.
+  for (std::uint64_t g : folder->snapshots)
+    if (g < generation && ::unlink(PathOf(true, g).c_str()) == 0) ++removed;
+  for (std::uint64_t g : folder->journals)
+    if (g < generation && ::unlink(PathOf(false, g).c_str()) == 0) ++removed;
+  static_cast<void>(SyncFolder(settings_.dir));
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  stats_.files_removed += removed;
+}
+
+}  // namespace msgraphs::runtime
