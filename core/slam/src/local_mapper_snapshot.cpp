@@ -10,10 +10,8 @@
 //
 // Layout: magic, version, payload length, payload CRC-32; the payload holds the graph's
 // snapshot (with its own header and CRC) behind its length, then the parts.
-#include <array>
 #include <cstring>
 
-#include "msgraphs/base/crc32.hpp"
 #include "msgraphs/base/snapshot_archive.hpp"
 #include "msgraphs/base/snapshot_header.hpp"
 #include "msgraphs/core/slam/local_mapper.hpp"

@@ -96,7 +96,12 @@ void Add(JournalReplay& sum, const JournalReplay& r) {
 
 }  // namespace
 
-Checkpoint::~Checkpoint() = default;
+Checkpoint::~Checkpoint() {
+  // Descriptors handed between threads and not yet synced (the process is ending: the kernel has
+  // the bytes; a power cut now loses at most what the sync period allows).
+  if (const int old = old_fd_.exchange(-1); old >= 0) ::close(old);
+  if (new_fd_ >= 0) ::close(new_fd_);
+}
 
 std::string Checkpoint::PathOf(bool snapshot, std::uint64_t generation) const {
   return CheckpointPath(settings_.dir, snapshot, generation);
@@ -113,10 +118,15 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
   std::filesystem::create_directories(settings.dir, ec);
   auto folder = ListCheckpointFolder(settings.dir);
   if (!folder) return folder.error();
+  bool rename_failed = false;
   const auto set_aside = [&](const std::string& path, const std::string& why) {
     const std::string to = SetAside(path);
-    restored.set_aside.push_back(path + " -> " + to + ": " + why);
+    rename_failed = rename_failed || to.empty();
+    restored.set_aside.push_back(path + " -> " + (to.empty() ? "(rename FAILED)" : to) + ": " + why);
   };
+  // Entries under our names that are not regular files (a FIFO would block the reader, a link
+  // redirect it) are never read.
+  for (const std::string& path : folder->not_regular) set_aside(path, "not a regular file");
 
   // The newest snapshot that checks.
   const auto t0 = std::chrono::steady_clock::now();
@@ -185,6 +195,17 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
   for (std::uint64_t j : folder->journals) {
     if (j < first) continue;
     const std::string path = c->PathOf(false, j);
+    if (!chain_ended && restored.journals > 0 && j == c->generation_ + 1) {
+      // It must say it continues the last one where that one's records end.
+      bool found = false;
+      std::uint64_t from = 0, at = 0;
+      if (Status s = ReadContinuation(path, settings.robot, found, from, at); !s) return s.error();
+      if (!found || from != c->generation_ || at != append_at) {
+        chain_ended = true;
+        set_aside(path, "it does not continue the journal before where that one ends");
+        continue;
+      }
+    }
     if (chain_ended || j != c->generation_ + (restored.journals == 0 ? 0 : 1)) {
       chain_ended = true;
       set_aside(path, "after a journal that ended early or is missing");
@@ -204,11 +225,36 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
   if (restored.replayed.last_odometry_s >= 0) restored.last_odometry_s = restored.replayed.last_odometry_s;
   restored.T_odom_last = sink.last_odometry;
   // Snapshots older than the one loaded stay until the next is durable (RemoveBelow).
+  if (rename_failed) return Error{Errc::kIo, "checkpoint: a file to set aside could not be renamed"};
+  if (!restored.set_aside.empty()) {
+    // The renames on disk before anything is appended: else a power cut could bring a file
+    // set aside back behind the new records.
+    if (Status s = SyncFolder(settings.dir); !s) return s.error();
+  }
+  if (sink.skip_messages > 0) {
+    // The snapshot's journal holds fewer peer messages than it counted (a disk that lost them):
+    // the session has them from the snapshot, but messages appended to that journal now would be
+    // skipped at the next restart. The node goes on in a new generation's journal instead.
+    restored.set_aside.push_back(c->PathOf(false, c->generation_) +
+                                 ": holds fewer peer messages than its snapshot counted; "
+                                 "a new journal begins");
+    {
+      auto cut = JournalWriter::Open(c->PathOf(false, c->generation_), settings.robot, append_at);
+      if (!cut) return cut.error();
+    }
+    auto next = JournalWriter::Open(c->PathOf(false, c->generation_ + 1), settings.robot, 0);
+    if (!next) return next.error();
+    if (Status s = next->Continues(c->generation_, append_at); !s) return s.error();
+    c->journal_.emplace(std::move(*next));
+    c->generation_ += 1;
+  }
 
   // Append to the newest journal of the chain (where its good records end).
-  auto writer = JournalWriter::Open(c->PathOf(false, c->generation_), settings.robot, append_at);
-  if (!writer) return writer.error();
-  c->journal_.emplace(std::move(*writer));
+  if (!c->journal_) {
+    auto writer = JournalWriter::Open(c->PathOf(false, c->generation_), settings.robot, append_at);
+    if (!writer) return writer.error();
+    c->journal_.emplace(std::move(*writer));
+  }
   if (settings.snapshot_every_keyframes > 0) {
     c->file_bytes_ = kCheckpointHeadBytes + mapper.SnapshotBytes();
     c->file_.assign(c->file_bytes_, 0);

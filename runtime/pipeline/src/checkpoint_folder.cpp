@@ -60,6 +60,12 @@ Expected<CheckpointFolder> ListCheckpointFolder(const std::string& dir) {
     bool snapshot = false;
     std::uint64_t generation = 0;
     if (CheckpointGeneration(name, snapshot, generation)) {
+      struct stat st {};
+      const std::string path = dir + "/" + name;
+      if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+        out.not_regular.push_back(path);
+        continue;
+      }
       (snapshot ? out.snapshots : out.journals).push_back(generation);
     } else if (name.rfind("snapshot.", 0) == 0 && name.size() > 4 &&
                name.compare(name.size() - 4, 4, ".tmp") == 0) {
@@ -74,7 +80,8 @@ Expected<CheckpointFolder> ListCheckpointFolder(const std::string& dir) {
 }
 
 Status ReadWholeFile(const std::string& path, std::size_t max_bytes, std::vector<std::uint8_t>& out) {
-  Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW));
+  // O_NONBLOCK: a FIFO under the name must not block the start (it is refused below).
+  Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK));
   if (fd.get() < 0) return IoError("cannot open the file (or it is a link)");
   struct stat st {};
   if (::fstat(fd.get(), &st) != 0) return IoError("cannot stat the file");
@@ -135,7 +142,10 @@ Status SyncFolder(const std::string& dir) {
 
 std::string SetAside(const std::string& path) {
   std::string to = path + ".dropped";
-  for (int i = 2; Exists(to) && i < 1000; ++i) to = path + ".dropped." + std::to_string(i);
+  for (int i = 2; Exists(to); ++i) {
+    if (i >= 1000) return {};  // never over an earlier one
+    to = path + ".dropped." + std::to_string(i);
+  }
   if (::rename(path.c_str(), to.c_str()) != 0) return {};
   return to;
 }

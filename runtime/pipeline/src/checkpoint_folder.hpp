@@ -17,8 +17,10 @@ std::string CheckpointPath(const std::string& dir, bool snapshot, std::uint64_t 
 
 struct CheckpointFolder {
   std::vector<std::uint64_t> snapshots, journals;  ///< generations present, ascending
+  std::vector<std::string> not_regular;  ///< entries with those names that are not regular files
 };
-/// The generations in `dir`; leftover snapshot.N.tmp files (a write cut short) are removed.
+/// The generations in `dir` (regular files only); leftover snapshot.N.tmp files (a write cut
+/// short) are removed.
 Expected<CheckpointFolder> ListCheckpointFolder(const std::string& dir);
 
 /// Reads `path` whole into `out` (resized); kCapacityExceeded beyond `max_bytes`, kIo when it

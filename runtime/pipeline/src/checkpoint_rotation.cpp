@@ -4,6 +4,8 @@
 // it durable and removes what the previous durable snapshot made redundant.
 #include <unistd.h>
 
+#include <cerrno>
+
 #include <algorithm>
 #include <chrono>
 
@@ -77,11 +79,24 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
     meta_.T_odom_last = odometry.pose(odometry.size() - 1);
   }
   mapper_bytes_ = **taken;
+  // A journal closed at an earlier switch whose snapshot failed before the writer synced it.
+  if (const int earlier = old_fd_.exchange(-1); earlier >= 0) {
+    if (::fdatasync(earlier) != 0) journal_errors_.fetch_add(1, std::memory_order_relaxed);
+    ::close(earlier);
+  }
   {
     std::lock_guard<std::mutex> lock(journal_mutex_);
+    // Its first record: where the old journal ends, which a restart checks before continuing.
+    if (!writer->Continues(generation_, journal_->bytes())) {
+      std::lock_guard<std::mutex> stats_lock(stats_mutex_);
+      ++stats_.snapshot_failures;
+      stats_.last_failure = "cannot write the new journal's first record";
+      return;
+    }
     writer->TakeBuffersFrom(*journal_);
-    closed_journal_.emplace(std::move(*journal_));
-    journal_.emplace(std::move(*writer));
+    old_synced_.store(false, std::memory_order_release);
+    old_fd_.store(journal_->DuplicateDescriptor(), std::memory_order_release);
+    journal_.emplace(std::move(*writer));  // the old writer closes; its dup stays open
     generation_ = next;
   }
   {
@@ -96,12 +111,22 @@ void Checkpoint::CaptureSession(core::CollabSession& session) {
   session_.clear();
   session_count_ = 0;
   SessionPart part(session_, session_count_);
-  static_cast<void>(session.ExportReceived(part));
+  const core::CollabExportStats exported = session.ExportReceived(part);
+  if (exported.failed > 0) {
+    // A peer's state missing from the snapshot would be lost once the journals holding it are
+    // removed: no snapshot this time (the new journal goes on; the chain stays whole).
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.snapshot_failures;
+    stats_.last_failure = "a peer's state did not encode";
+    state_.store(State::kIdle, std::memory_order_release);
+    return;
+  }
   {
     // Every peer message journaled since the switch was received by the session before this
     // (both happen under the session's lock): the export holds them; replay skips them.
     std::lock_guard<std::mutex> lock(journal_mutex_);
     meta_.journal_messages = journal_->messages();
+    new_fd_ = journal_->DuplicateDescriptor();
   }
   state_.store(State::kWrite, std::memory_order_release);
   Wake();
@@ -139,12 +164,40 @@ void Checkpoint::RunWriter(const std::function<bool()>& stop) {
   }
 }
 
+void Checkpoint::Sync() {
+  bool ok = true;
+  if (const int old = old_fd_.exchange(-1); old >= 0) {
+    ok = ::fdatasync(old) == 0;
+    ::close(old);
+    old_synced_.store(true, std::memory_order_release);
+  }
+  // The writer thread holds the old one and is syncing it: the new one waits for the next call.
+  if (ok && old_synced_.load(std::memory_order_acquire)) {
+    std::lock_guard<std::mutex> lock(journal_mutex_);
+    ok = static_cast<bool>(journal_->Sync());
+  }
+  if (!ok) journal_errors_.fetch_add(1, std::memory_order_relaxed);
+}
+
 Status Checkpoint::WriteSnapshot() {
   // The journal the switch closed: complete on disk before anything relies on the new one.
-  if (closed_journal_) {
-    const Status synced = closed_journal_->Sync();
-    closed_journal_.reset();
-    if (!synced) return synced;
+  if (const int old = old_fd_.exchange(-1); old >= 0) {
+    const bool synced = ::fdatasync(old) == 0;
+    ::close(old);
+    old_synced_.store(true, std::memory_order_release);
+    if (!synced) {
+      if (new_fd_ >= 0) ::close(new_fd_);
+      new_fd_ = -1;
+      return Error{Errc::kIo, "cannot fdatasync the journal the switch closed", errno};
+    }
+  }
+  // The new journal up to the capture: the peer messages the snapshot counts as held are on disk
+  // before the snapshot is (a restart skips exactly that many).
+  if (new_fd_ >= 0) {
+    const bool synced = ::fdatasync(new_fd_) == 0;
+    ::close(new_fd_);
+    new_fd_ = -1;
+    if (!synced) return Error{Errc::kIo, "cannot fdatasync the new journal", errno};
   }
   // The new journal's name: a snapshot never exists without its journal's entry.
   if (Status s = SyncFolder(settings_.dir); !s) return s;
@@ -179,6 +232,7 @@ void Checkpoint::RemoveBelow(std::uint64_t generation) {
   // Snapshots first: a journal is never gone while a snapshot that needs it is there.
   for (std::uint64_t g : folder->snapshots)
     if (g < generation && ::unlink(PathOf(true, g).c_str()) == 0) ++removed;
+  static_cast<void>(SyncFolder(settings_.dir));  // the snapshots' removal first on disk too
   for (std::uint64_t g : folder->journals)
     if (g < generation && ::unlink(PathOf(false, g).c_str()) == 0) ++removed;
   static_cast<void>(SyncFolder(settings_.dir));

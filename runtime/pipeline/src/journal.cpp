@@ -2,6 +2,7 @@
 #include "msgraphs/runtime/pipeline/journal.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -97,6 +98,14 @@ Eigen::Isometry3d GetPose(In& in) {
 
 Status IoError(const char* what) { return Error{Errc::kIo, what, errno}; }
 
+// Whether `path` is absent or a regular file: a FIFO, device or link planted under a journal's
+// name would block or redirect the reader.
+bool AbsentOrRegular(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return errno == ENOENT;
+  return S_ISREG(st.st_mode);
+}
+
 // Whether every f64 of a record's payload is finite: `bytes` all f64s (lead 0), or blocks of a
 // `lead`-byte id followed by 13 f64s (priors: plane u32, normal, d, covariance). A NaN in the
 // file is refused like a bad CRC: replay stops there, as it does at any record it cannot use.
@@ -128,8 +137,12 @@ Expected<JournalWriter> JournalWriter::Open(const std::string& path,
       return IoError("journal: cannot write the header").error();
     w.bytes_ = header.size();
   } else {
-    // Cut a torn tail, append after the last good record.
-    if (::ftruncate(fd, static_cast<off_t>(valid_bytes)) != 0)
+    // Cut a torn tail, append after the last good record. Synced: records appended after the
+    // cut must never reach the disk behind the torn bytes they replace.
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) return IoError("journal: cannot stat").error();
+    if (static_cast<std::uint64_t>(st.st_size) != valid_bytes &&
+        (::ftruncate(fd, static_cast<off_t>(valid_bytes)) != 0 || ::fdatasync(fd) != 0))
       return IoError("journal: cannot truncate").error();
     w.bytes_ = valid_bytes;
   }
@@ -248,6 +261,43 @@ void JournalWriter::TakeBuffersFrom(JournalWriter& other) {
   record_.swap(other.record_);
 }
 
+Status JournalWriter::Continues(std::uint64_t generation, std::uint64_t bytes) {
+  Out o(buffer_);
+  o.U32(static_cast<std::uint32_t>(generation));
+  o.U32(static_cast<std::uint32_t>(generation >> 32));
+  o.U32(static_cast<std::uint32_t>(bytes));
+  o.U32(static_cast<std::uint32_t>(bytes >> 32));
+  return Write(JournalRecord::kContinues, buffer_);
+}
+
+int JournalWriter::DuplicateDescriptor() const { return ::fcntl(fd_, F_DUPFD_CLOEXEC, 0); }
+
+Status ReadContinuation(const std::string& path, std::uint16_t robot, bool& found,
+                        std::uint64_t& generation, std::uint64_t& bytes) {
+  found = false;
+  if (!AbsentOrRegular(path)) return Error{Errc::kInvalidArgument, "journal: not a regular file"};
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Ok();
+  const std::string expected = Header(robot);
+  std::string header(expected.size(), '\0');
+  std::uint8_t record[kRecordHeader + 16];
+  if (!file.read(header.data(), static_cast<std::streamsize>(header.size())) || header != expected ||
+      !file.read(reinterpret_cast<char*>(record), sizeof record))
+    return Ok();
+  if (record[0] != static_cast<std::uint8_t>(JournalRecord::kContinues) ||
+      ReadU32Le(&record[4]) != 16)
+    return Ok();
+  std::uint8_t covered[17];
+  covered[0] = record[0];
+  std::memcpy(covered + 1, record + kRecordHeader, 16);
+  if (Crc32(covered) != ReadU32Le(&record[8])) return Ok();
+  const std::uint8_t* p = record + kRecordHeader;
+  generation = ReadU32Le(p) | static_cast<std::uint64_t>(ReadU32Le(p + 4)) << 32;
+  bytes = ReadU32Le(p + 8) | static_cast<std::uint64_t>(ReadU32Le(p + 12)) << 32;
+  found = true;
+  return Ok();
+}
+
 Status JournalWriter::Sync() {
   if (::fdatasync(fd_) != 0) return IoError("journal: fsync failed");
   return Ok();
@@ -256,6 +306,7 @@ Status JournalWriter::Sync() {
 Expected<JournalReplay> ReplayJournal(const std::string& path,
                                       std::uint16_t robot,
                                       JournalSink& sink) {
+  if (!AbsentOrRegular(path)) return Error{Errc::kInvalidArgument, "journal: not a regular file"};
   std::ifstream file(path, std::ios::binary);
   if (!file) return JournalReplay{};  // no journal yet: a fresh start
   return ReplayJournal(file, robot, sink);
@@ -367,6 +418,17 @@ Expected<JournalReplay> ReplayJournal(std::istream& file, std::uint16_t robot, J
         if (!(ok = tracked <= 1 && std::isfinite(end))) break;
         sink.OnMotion(end, T, tracked == 1);
         ++r.motions;
+        break;
+      }
+      case JournalRecord::kContinues: {
+        // Only as the first record (ReadContinuation reads it there; elsewhere it is no record
+        // this writer makes).
+        if (!(ok = length == 16 && r.records == 0)) break;
+        const std::uint64_t g_lo = in.U32(), g_hi = in.U32();
+        const std::uint64_t b_lo = in.U32(), b_hi = in.U32();
+        r.continues = true;
+        r.continues_generation = g_lo | g_hi << 32;
+        r.continues_bytes = b_lo | b_hi << 32;
         break;
       }
       default:

@@ -280,7 +280,7 @@ void Node::Impl::SlamLoop() {
       slam_status.keyframe_p99_ms = keyframe_ms.Percentile(0.99);
     }
     if (checkpoint && platform::SteadyNow() >= next_sync) {
-      Journal([](JournalWriter& j) { return static_cast<bool>(j.Sync()); });
+      checkpoint->Sync();
       next_sync = platform::SteadyNow() + Duration::FromSeconds(config.checkpoint_sync_s);
     }
     if (next_exchange_s < 0) next_exchange_s = end_s + config.exchange_period_s;
@@ -293,7 +293,8 @@ void Node::Impl::SlamLoop() {
 
   // The recording ended: a final full solve, then keep serving the fleet.
   static_cast<void>(mapper.Finish());
-  Journal([](JournalWriter& j) { return j.Finish() && j.Sync(); });
+  Journal([](JournalWriter& j) { return static_cast<bool>(j.Finish()); });
+  if (checkpoint) checkpoint->Sync();
   state = link::NodeState::kInputDone;
   exchange_owed = !Exchange();
   const Duration period = Duration::FromSeconds(std::min(config.exchange_period_s, 1.0));

@@ -15,20 +15,24 @@
 // - SLAM thread (AfterKeyframe, after the keyframe's records): asks the mapper for a snapshot;
 //   the mapper takes it at the end of a keyframe with no full solve pending
 //   (LocalMapper::RequestSnapshot). Right after that keyframe's records the journal switches to
-//   journal.N.bin (a new file's header; no sync on this thread).
+//   journal.N.bin, whose first record says where the old one ended (kContinues; no sync on this
+//   thread). Its periodic Sync syncs the old journal first if the writer has not yet.
 // - Collab thread (CaptureSession, with the session locked): the session's peer state
 //   (CollabSession::ExportReceived), and how many peer messages journal.N.bin already holds,
 //   which replay skips. Messages are journaled under the session lock, so the count is exact.
-// - Writer thread (RunWriter): syncs the old journal and the folder, writes snapshot.N.tmp,
-//   fsyncs, renames it to snapshot.N.bin, syncs the folder, and only then removes the files of
+// - Writer thread (RunWriter): syncs the old journal, the new one up to the capture (the messages
+//   the snapshot counts are on disk before it is) and the folder, writes snapshot.N.tmp, fsyncs,
+//   renames it to snapshot.N.bin, syncs the folder, and only then removes the files of
 //   generations below the previous durable snapshot (snapshots first, then journals, oldest
 //   first), so that a power cut at any step leaves a snapshot and the journals after it.
 //
 // Restart (Open): snapshots newest first; one that does not check (CRC, robot, generation, the
 // mapper settings' CRC, the mapper's own checks) is renamed *.dropped and the next older one is
 // tried. The journals from the snapshot's generation on are replayed in order; a journal that
-// ends early (torn, corrupt) ends the chain there, and later ones are set aside, so the state is
-// always a prefix of what happened. With no usable snapshot, journal.bin is replayed from the
+// ends early (torn, corrupt), or one whose successor does not continue it where it ended
+// (kContinues), ends the chain there, and later ones are set aside, so the state is always a
+// prefix of what happened. Files set aside are renamed before anything is appended, and the
+// folder synced; a rename that fails fails Open. With no usable snapshot, journal.bin is replayed from the
 // start; when it was already removed, the node starts empty and says so.
 #pragma once
 
@@ -106,6 +110,11 @@ class Checkpoint {
     if (!write(*journal_)) journal_errors_.fetch_add(1, std::memory_order_relaxed);
   }
 
+  /// fdatasync of the journal (the SLAM thread's period, and at the mission's end). The journal a
+  /// switch closed is synced first: a generation's records are never on disk while the tail of
+  /// the one before may not be. While the writer thread is syncing that one, this waits for the
+  /// next call. A failure is counted (journal_errors).
+  void Sync();
   /// SLAM thread, after each keyframe's records: asks for a snapshot when one is due, and
   /// switches the journal once the mapper took it. `scan_end_s` is that keyframe's scan end.
   void AfterKeyframe(core::LocalMapper& mapper, double scan_end_s);
@@ -144,7 +153,12 @@ class Checkpoint {
   std::uint32_t session_count_ = 0;
   std::size_t mapper_bytes_ = 0;
   CheckpointMeta meta_;
-  std::optional<JournalWriter> closed_journal_;
+  // The journal a switch closed, as a descriptor to fdatasync (whoever comes first: the writer
+  // thread, or Sync), and whether it is synced; the new journal's, taken at the capture, that the
+  // writer syncs before the snapshot that counts its messages becomes durable.
+  std::atomic<int> old_fd_{-1};
+  std::atomic<bool> old_synced_{true};
+  int new_fd_ = -1;
   std::uint64_t durable_ = 0;  // the newest durable snapshot (0: none)
   std::mutex wake_mutex_;
   std::condition_variable wake_;

@@ -27,6 +27,10 @@
 //   kMotion    end f64, x y z f64, qx qy qz qw f64, tracked u8: the next keyframe's motion since
 //              the previous one, as tracked live (65 bytes). A journal without them (written
 //              before scan tracking) replays its keyframe scans through AddScan.
+//   kContinues generation u64, bytes u64: the first record of a checkpoint generation's
+//              journal (checkpoint.hpp): the journal it continues, and where that one's records
+//              ended when this one began. A restart continues into this journal only when the
+//              previous one replayed to exactly there (never over a hole).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -48,7 +52,8 @@ enum class JournalRecord : std::uint8_t {
   kPriors = 3,
   kFinish = 4,
   kMessage = 5,
-  kMotion = 6
+  kMotion = 6,
+  kContinues = 7
 };
 
 class JournalWriter {
@@ -73,8 +78,14 @@ class JournalWriter {
   Status Message(core::CollabMessageType type, std::span<const std::uint8_t> bytes);
   /// The motion of the keyframe whose scan follows (ending at `end_s`).
   Status Motion(double end_s, const Eigen::Isometry3d& T_last_new, bool tracked);
+  /// The first record of a generation's journal: it continues `generation`'s, whose records
+  /// ended at `bytes`.
+  Status Continues(std::uint64_t generation, std::uint64_t bytes);
   /// fsync: everything written so far survives a power cut.
   Status Sync();
+  /// A second descriptor of the file (the caller closes it): to fdatasync it on another thread,
+  /// outside the journal's lock, or after this writer is gone. -1 when dup fails.
+  int DuplicateDescriptor() const;
   std::uint64_t bytes() const { return bytes_; }
   std::uint64_t records() const { return records_; }
   /// kMessage records written through this writer.
@@ -97,6 +108,9 @@ struct JournalReplay {
   std::uint64_t records = 0, odometry = 0, scans = 0, priors = 0, finishes = 0, messages = 0,
                 motions = 0;
   double last_scan_end_s = -1, last_odometry_s = -1;
+  /// Its kContinues record, when it has one: the journal it continues and where that one ended.
+  bool continues = false;
+  std::uint64_t continues_generation = 0, continues_bytes = 0;
   std::string stopped;  ///< empty when the file ended cleanly, else why replay stopped early
 };
 
@@ -120,6 +134,10 @@ class JournalSink {
 Expected<JournalReplay> ReplayJournal(const std::string& path,
                                       std::uint16_t robot,
                                       JournalSink& sink);
+/// The kContinues record at the start of `path` (header and first record only, CRC-checked):
+/// false in `found` when the file is missing, empty or starts otherwise.
+Status ReadContinuation(const std::string& path, std::uint16_t robot, bool& found,
+                        std::uint64_t& generation, std::uint64_t& bytes);
 /// The same from a stream (the fuzz target's bytes). A record whose numbers are not finite is
 /// where replay stops, as at a bad CRC.
 Expected<JournalReplay> ReplayJournal(std::istream& in, std::uint16_t robot, JournalSink& sink);
