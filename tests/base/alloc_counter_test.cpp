@@ -126,5 +126,17 @@ TEST(Crc32, IsTheIeeeCrcAndNeverAllocates) {
   EXPECT_EQ(message_crc, expected);
 }
 
+// A file's CRC taken over its parts (the checkpoint's snapshot: the mapper's bytes, then the
+// session's) is the CRC of the whole, wherever it is cut.
+TEST(Crc32, ContinuedOverPartsIsTheCrcOfTheWhole) {
+  std::vector<std::uint8_t> message(1000);
+  for (std::size_t i = 0; i < message.size(); ++i) message[i] = static_cast<std::uint8_t>(i * 13 + 1);
+  const std::uint32_t whole = Crc32(message);
+  for (std::size_t cut : {std::size_t{0}, std::size_t{1}, std::size_t{499}, std::size_t{1000}}) {
+    const std::span<const std::uint8_t> all(message);
+    EXPECT_EQ(Crc32Continue(Crc32(all.first(cut)), all.subspan(cut)), whole) << cut;
+  }
+}
+
 }  // namespace
 }  // namespace msgraphs

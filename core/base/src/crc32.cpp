@@ -20,8 +20,10 @@ constexpr std::array<std::uint32_t, 256> kTable = MakeTable();
 
 }  // namespace
 
-std::uint32_t Crc32(std::span<const std::uint8_t> bytes) noexcept {
-  std::uint32_t c = 0xFFFFFFFFu;
+std::uint32_t Crc32(std::span<const std::uint8_t> bytes) noexcept { return Crc32Continue(0, bytes); }
+
+std::uint32_t Crc32Continue(std::uint32_t crc_of_before, std::span<const std::uint8_t> bytes) noexcept {
+  std::uint32_t c = crc_of_before ^ 0xFFFFFFFFu;
   for (std::uint8_t b : bytes) c = kTable[(c ^ b) & 0xFFu] ^ (c >> 8);
   return c ^ 0xFFFFFFFFu;
 }

@@ -257,7 +257,7 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
   }
   if (settings.snapshot_every_keyframes > 0) {
     c->file_bytes_ = kCheckpointHeadBytes + mapper.SnapshotBytes();
-    c->file_.assign(c->file_bytes_, 0);
+    c->file_.reset(new std::uint8_t[c->file_bytes_]);  // not zeroed: see file_
   }
   c->stats_.generation = c->generation_;
   c->stats_.durable_generation = c->durable_;

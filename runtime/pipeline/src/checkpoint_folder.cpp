@@ -100,20 +100,22 @@ Status ReadWholeFile(const std::string& path, std::size_t max_bytes, std::vector
 }
 
 Status WriteFileDurably(const std::string& dir, const std::string& path,
-                        std::span<const std::uint8_t> bytes) {
+                        std::span<const std::span<const std::uint8_t>> parts) {
   const std::string tmp = path.substr(0, path.size() - 4) + ".tmp";  // name.bin -> name.tmp
   Fd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644));
   if (fd.get() < 0) return IoError("cannot create the snapshot's temporary file");
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd.get(), bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const Status e = IoError("cannot write the snapshot (disk full?)");
-      ::unlink(tmp.c_str());
-      return e;
+  for (const std::span<const std::uint8_t> bytes : parts) {
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(fd.get(), bytes.data() + done, bytes.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const Status e = IoError("cannot write the snapshot (disk full?)");
+        ::unlink(tmp.c_str());
+        return e;
+      }
+      done += static_cast<std::size_t>(n);
     }
-    done += static_cast<std::size_t>(n);
   }
   if (::fsync(fd.get()) != 0) {
     const Status e = IoError("cannot fsync the snapshot");

@@ -27,9 +27,10 @@ Expected<CheckpointFolder> ListCheckpointFolder(const std::string& dir);
 /// cannot be read. A link is not followed.
 Status ReadWholeFile(const std::string& path, std::size_t max_bytes, std::vector<std::uint8_t>& out);
 
-/// Writes `bytes` to `path` durably: to path.tmp, fsync, rename, fsync of the folder.
+/// Writes `parts`, one after the other, to `path` durably: to name.tmp, fsync, rename, fsync of
+/// the folder.
 Status WriteFileDurably(const std::string& dir, const std::string& path,
-                        std::span<const std::uint8_t> bytes);
+                        std::span<const std::span<const std::uint8_t>> parts);
 
 /// fsync of the folder itself: a file created, renamed or removed in it survives a power cut.
 Status SyncFolder(const std::string& dir);

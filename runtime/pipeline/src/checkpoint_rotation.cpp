@@ -42,7 +42,7 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
     if (keyframes_since_ < settings_.snapshot_every_keyframes ||
         state_.load(std::memory_order_acquire) != State::kIdle)
       return;
-    mapper.RequestSnapshot(std::span(file_).subspan(kCheckpointHeadBytes));
+    mapper.RequestSnapshot(std::span(file_.get() + kCheckpointHeadBytes, file_bytes_ - kCheckpointHeadBytes));
     requested_ = true;
     // The mapper may take it at this very keyframe's end only if asked before it: it is asked
     // now, for the next keyframe with no solve pending.
@@ -108,7 +108,7 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
 
 void Checkpoint::CaptureSession(core::CollabSession& session) {
   if (state_.load(std::memory_order_acquire) != State::kSession) return;
-  session_.clear();
+  session_.assign(4, 0);  // the count, written when known
   session_count_ = 0;
   SessionPart part(session_, session_count_);
   const core::CollabExportStats exported = session.ExportReceived(part);
@@ -201,21 +201,21 @@ Status Checkpoint::WriteSnapshot() {
   }
   // The new journal's name: a snapshot never exists without its journal's entry.
   if (Status s = SyncFolder(settings_.dir); !s) return s;
-  const std::size_t session_at = kCheckpointHeadBytes + mapper_bytes_;
-  file_.resize(session_at + 4 + session_.size() + 4);
+  // The file: head and mapper's bytes (file_), then the session's count and messages and the
+  // CRC-32 of everything before it (session_).
   WriteCheckpointHead(meta_, mapper_bytes_,
-                      std::span<std::uint8_t, kCheckpointHeadBytes>(file_.data(), kCheckpointHeadBytes));
-  WriteU32Le(file_.data() + session_at, session_count_);
-  std::copy(session_.begin(), session_.end(), file_.begin() + static_cast<std::ptrdiff_t>(session_at + 4));
-  const std::span<const std::uint8_t> body(file_.data(), file_.size() - 4);
-  WriteU32Le(file_.data() + body.size(), Crc32(body));
-  const Status written = WriteFileDurably(settings_.dir, PathOf(true, meta_.generation), file_);
+                      std::span<std::uint8_t, kCheckpointHeadBytes>(file_.get(), kCheckpointHeadBytes));
+  const std::span<const std::uint8_t> head(file_.get(), kCheckpointHeadBytes + mapper_bytes_);
+  WriteU32Le(session_.data(), session_count_);
+  const std::uint32_t crc = Crc32Continue(Crc32(head), session_);
+  session_.resize(session_.size() + 4);
+  WriteU32Le(session_.data() + session_.size() - 4, crc);
+  const std::span<const std::uint8_t> parts[] = {head, session_};
+  const Status written = WriteFileDurably(settings_.dir, PathOf(true, meta_.generation), parts);
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
-    stats_.last_snapshot_bytes = file_.size();
+    stats_.last_snapshot_bytes = head.size() + session_.size();
   }
-  // Back to the head and the mapper's room for the next request (capacity kept).
-  file_.resize(file_bytes_);
   if (!written) return written;
   const std::uint64_t previous = durable_;
   durable_ = meta_.generation;

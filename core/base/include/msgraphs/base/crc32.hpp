@@ -9,5 +9,7 @@
 namespace msgraphs {
 
 std::uint32_t Crc32(std::span<const std::uint8_t> bytes) noexcept;
+/// The CRC of a file written in parts: Crc32Continue(Crc32(a), b) == Crc32(a then b).
+std::uint32_t Crc32Continue(std::uint32_t crc_of_before, std::span<const std::uint8_t> bytes) noexcept;
 
 }  // namespace msgraphs

@@ -148,8 +148,11 @@ class Checkpoint {
   // The snapshot under way: head + the mapper's bytes in file_, the session's messages in
   // session_, the journal it closed, its meta. Handed from thread to thread through state_.
   std::atomic<State> state_{State::kIdle};
-  std::vector<std::uint8_t> file_, session_;
-  std::size_t file_bytes_ = 0;  // the head and the mapper's SnapshotBytes
+  // file_: the head and the mapper's SnapshotBytes, allocated once and never cleared (only the
+  // part a snapshot writes is touched: no pages of the bound that a map never reaches).
+  std::unique_ptr<std::uint8_t[]> file_;
+  std::size_t file_bytes_ = 0;
+  std::vector<std::uint8_t> session_;  // the session's part: count, messages, then the CRC
   std::uint32_t session_count_ = 0;
   std::size_t mapper_bytes_ = 0;
   CheckpointMeta meta_;
