@@ -191,7 +191,7 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
   const auto t1 = std::chrono::steady_clock::now();
   c->generation_ = first;
   std::uint64_t append_at = 0;
-  bool chain_ended = false;
+  bool chain_ended = false, short_journal = base.has_value() && base->journal_messages > 0;
   for (std::uint64_t j : folder->journals) {
     if (j < first) continue;
     const std::string path = c->PathOf(false, j);
@@ -213,7 +213,13 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
     }
     auto r = ReplayJournal(path, settings.robot, sink);
     if (!r) return r.error();
-    if (j == first) sink.skip_messages = 0;  // only the snapshot's own generation had them
+    if (j == first && base) {
+      // Only the snapshot's own generation's journal had them. Fewer there than counted: the
+      // disk lost some (see below).
+      restored.messages_skipped = base->journal_messages - sink.skip_messages;
+      short_journal = sink.skip_messages > 0;
+      sink.skip_messages = 0;
+    }
     Add(restored.replayed, *r);
     ++restored.journals;
     c->generation_ = j;
@@ -231,22 +237,36 @@ Expected<std::unique_ptr<Checkpoint>> Checkpoint::Open(const CheckpointSettings&
     // set aside back behind the new records.
     if (Status s = SyncFolder(settings.dir); !s) return s.error();
   }
-  if (sink.skip_messages > 0) {
+  if (short_journal && c->generation_ == first) {
     // The snapshot's journal holds fewer peer messages than it counted (a disk that lost them):
     // the session has them from the snapshot, but messages appended to that journal now would be
     // skipped at the next restart. The node goes on in a new generation's journal instead.
     restored.set_aside.push_back(c->PathOf(false, c->generation_) +
                                  ": holds fewer peer messages than its snapshot counted; "
                                  "a new journal begins");
+    std::uint64_t ends_at = 0;
     {
+      // The short journal (created when missing, cut after its last good record), synced: the
+      // next one continues it from its end.
       auto cut = JournalWriter::Open(c->PathOf(false, c->generation_), settings.robot, append_at);
       if (!cut) return cut.error();
+      if (Status s = cut->Sync(); !s) return s.error();
+      ends_at = cut->bytes();
     }
     auto next = JournalWriter::Open(c->PathOf(false, c->generation_ + 1), settings.robot, 0);
     if (!next) return next.error();
-    if (Status s = next->Continues(c->generation_, append_at); !s) return s.error();
+    if (Status s = next->Continues(c->generation_, ends_at); !s) return s.error();
+    if (Status s = next->Sync(); !s) return s.error();
+    if (Status s = SyncFolder(settings.dir); !s) return s.error();
     c->journal_.emplace(std::move(*next));
     c->generation_ += 1;
+  }
+  // The journals before the newest on disk before anything is appended to it: a crash (no power
+  // cut) may have left their tails in the page cache only, and the newest's records must never
+  // be durable while theirs may not be.
+  for (std::uint64_t j : folder->journals) {
+    if (j < first || j >= c->generation_) continue;
+    if (Status s = SyncFile(c->PathOf(false, j)); !s) return s.error();
   }
 
   // Append to the newest journal of the chain (where its good records end).

@@ -135,6 +135,13 @@ Status WriteFileDurably(const std::string& dir, const std::string& path,
   return SyncFolder(dir);
 }
 
+Status SyncFile(const std::string& path) {
+  Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK));
+  if (fd.get() < 0) return IoError("cannot open a journal to sync it");
+  if (::fdatasync(fd.get()) != 0) return IoError("cannot fdatasync a journal");
+  return Ok();
+}
+
 Status SyncFolder(const std::string& dir) {
   Fd fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (fd.get() < 0) return IoError("cannot open the checkpoint folder to sync it");

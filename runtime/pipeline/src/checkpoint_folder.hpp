@@ -32,6 +32,9 @@ Status ReadWholeFile(const std::string& path, std::size_t max_bytes, std::vector
 Status WriteFileDurably(const std::string& dir, const std::string& path,
                         std::span<const std::span<const std::uint8_t>> parts);
 
+/// fdatasync of a file (opened for reading, not following links).
+Status SyncFile(const std::string& path);
+
 /// fsync of the folder itself: a file created, renamed or removed in it survives a power cut.
 Status SyncFolder(const std::string& dir);
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <thread>
 
 #include "checkpoint_folder.hpp"
 #include "msgraphs/base/byte_order.hpp"
@@ -94,10 +95,16 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
       return;
     }
     writer->TakeBuffersFrom(*journal_);
-    old_synced_.store(false, std::memory_order_release);
-    old_fd_.store(journal_->DuplicateDescriptor(), std::memory_order_release);
+    const int old = journal_->DuplicateDescriptor();
+    if (old >= 0) {
+      old_synced_.store(false, std::memory_order_release);
+      old_fd_.store(old, std::memory_order_release);
+    } else if (!journal_->Sync()) {  // no descriptor to hand over (EMFILE): synced here, once
+      journal_errors_.fetch_add(1, std::memory_order_relaxed);
+    }
     journal_.emplace(std::move(*writer));  // the old writer closes; its dup stays open
     generation_ = next;
+    folder_synced_ = false;
   }
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
@@ -127,6 +134,14 @@ void Checkpoint::CaptureSession(core::CollabSession& session) {
     std::lock_guard<std::mutex> lock(journal_mutex_);
     meta_.journal_messages = journal_->messages();
     new_fd_ = journal_->DuplicateDescriptor();
+  }
+  if (new_fd_ < 0) {
+    // The new journal could not be synced before the snapshot that counts its messages.
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.snapshot_failures;
+    stats_.last_failure = "no descriptor to sync the new journal";
+    state_.store(State::kIdle, std::memory_order_release);
+    return;
   }
   state_.store(State::kWrite, std::memory_order_release);
   Wake();
@@ -164,17 +179,28 @@ void Checkpoint::RunWriter(const std::function<bool()>& stop) {
   }
 }
 
-void Checkpoint::Sync() {
+void Checkpoint::Sync(bool final) {
   bool ok = true;
   if (const int old = old_fd_.exchange(-1); old >= 0) {
     ok = ::fdatasync(old) == 0;
     ::close(old);
     old_synced_.store(true, std::memory_order_release);
   }
-  // The writer thread holds the old one and is syncing it: the new one waits for the next call.
+  // The writer thread holds the old one and is syncing it: the new one waits for the next call,
+  // or, at the mission's end, for the writer.
+  for (int waited_ms = 0; final && !old_synced_.load(std::memory_order_acquire) && waited_ms < 10000;
+       ++waited_ms)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // A failed sync of the old one leaves the new one unsynced too (its records must not be on
+  // disk without the old one's tail); the next call tries again with the new one only.
   if (ok && old_synced_.load(std::memory_order_acquire)) {
-    std::lock_guard<std::mutex> lock(journal_mutex_);
-    ok = static_cast<bool>(journal_->Sync());
+    {
+      std::lock_guard<std::mutex> lock(journal_mutex_);
+      ok = static_cast<bool>(journal_->Sync());
+    }
+    // The newest journal's name, once after each switch (the writer syncs it too, but not when
+    // that generation's snapshot failed before).
+    if (ok && !folder_synced_) ok = folder_synced_ = static_cast<bool>(SyncFolder(settings_.dir));
   }
   if (!ok) journal_errors_.fetch_add(1, std::memory_order_relaxed);
 }

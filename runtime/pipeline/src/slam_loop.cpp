@@ -294,7 +294,7 @@ void Node::Impl::SlamLoop() {
   // The recording ended: a final full solve, then keep serving the fleet.
   static_cast<void>(mapper.Finish());
   Journal([](JournalWriter& j) { return static_cast<bool>(j.Finish()); });
-  if (checkpoint) checkpoint->Sync();
+  if (checkpoint) checkpoint->Sync(/*final=*/true);
   state = link::NodeState::kInputDone;
   exchange_owed = !Exchange();
   const Duration period = Duration::FromSeconds(std::min(config.exchange_period_s, 1.0));

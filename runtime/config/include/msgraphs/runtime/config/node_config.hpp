@@ -97,7 +97,7 @@ struct NodeConfig {
   /// A snapshot (and a new journal) every this many keyframes: the journal is compacted, and a
   /// restart loads the snapshot and replays the keyframes since (docs/runtime.md). 0: the
   /// journal only, replayed whole at a restart.
-  std::size_t snapshot_every_keyframes = 100;
+  std::size_t snapshot_every_keyframes = 50;
   /// CRC-32 of what shapes the map that the config file sets ([mapping], [rooms], the odometry
   /// noise, T_base_lidar): a snapshot made under other values is not loaded (derived, not read).
   std::uint32_t mapper_settings_crc = 0;

@@ -61,7 +61,7 @@ struct CheckpointSettings {
   /// snapshot made under other settings is not loaded.
   std::uint32_t mapper_settings_crc = 0;
   /// A generation every this many keyframes; 0: the journal only (journal.bin, never compacted).
-  std::size_t snapshot_every_keyframes = 100;
+  std::size_t snapshot_every_keyframes = 50;
 };
 
 /// What Open rebuilt.
@@ -69,6 +69,8 @@ struct CheckpointRestore {
   bool from_snapshot = false;
   std::uint64_t snapshot_generation = 0;
   std::size_t session_messages = 0;  ///< peer messages the snapshot gave the session
+  /// Peer messages of the snapshot's journal that replay skipped (the snapshot held them).
+  std::uint64_t messages_skipped = 0;
   std::size_t journals = 0;          ///< journals replayed
   /// Summed over the journals replayed; the stamps are the newest from the snapshot and them.
   JournalReplay replayed;
@@ -114,7 +116,9 @@ class Checkpoint {
   /// switch closed is synced first: a generation's records are never on disk while the tail of
   /// the one before may not be. While the writer thread is syncing that one, this waits for the
   /// next call. A failure is counted (journal_errors).
-  void Sync();
+  /// `final` (the mission's end): waits for the writer to finish syncing the old journal rather
+  /// than leaving the new one for the next call.
+  void Sync(bool final = false);
   /// SLAM thread, after each keyframe's records: asks for a snapshot when one is due, and
   /// switches the journal once the mapper took it. `scan_end_s` is that keyframe's scan end.
   void AfterKeyframe(core::LocalMapper& mapper, double scan_end_s);
@@ -161,6 +165,7 @@ class Checkpoint {
   // writer syncs before the snapshot that counts its messages becomes durable.
   std::atomic<int> old_fd_{-1};
   std::atomic<bool> old_synced_{true};
+  bool folder_synced_ = true;  // the newest journal's name (SLAM thread)
   int new_fd_ = -1;
   std::uint64_t durable_ = 0;  // the newest durable snapshot (0: none)
   std::mutex wake_mutex_;
