@@ -133,6 +133,31 @@ TEST(NodeConfig, OverridesReplaceOrAddAndAreCheckedToo) {
   EXPECT_EQ(ErrorOf("[robot]\nid = 1\n", {"nodot=1"}), "--set nodot=1: expected section.key=value");
 }
 
+// A snapshot made under other mapper settings is not loaded (checkpoint.hpp): the CRC changes with
+// every key that shapes the map, and with none that does not (the robot's speed of replay, the
+// link, the checkpoint's own keys).
+TEST(NodeConfig, TheMapperSettingsCrcFollowsWhatShapesTheMapOnly) {
+  const auto crc_with = [](const std::vector<std::string>& overrides) {
+    NodeConfig c;
+    std::string error;
+    EXPECT_TRUE(Parse("[robot]\nid = 3\n", c, error, overrides)) << error;
+    return c.mapper_settings_crc;
+  };
+  const std::uint32_t base = crc_with({});
+  EXPECT_EQ(crc_with({}), base);
+  EXPECT_EQ(crc_with({"robot.id=4"}), base);
+  EXPECT_EQ(crc_with({"link.domain=9"}), base);
+  EXPECT_EQ(crc_with({"checkpoint.snapshot_every_keyframes=7"}), base);
+  EXPECT_EQ(crc_with({"checkpoint.sync_period_s=1"}), base);
+  for (const char* shapes :
+       {"mapping.keyframe_spacing_m=0.7", "mapping.max_range_m=30", "mapping.max_keyframes=2000",
+        "mapping.cloud_store_points=2000000", "mapping.full_solve_lag_keyframes=2",
+        "mapping.grid_half_extent_m=60", "mapping.track_scans=false",
+        "rooms.door_cut_clearance_m=0.6", "odometry.sigma_per_m=0.05",
+        "lidar.T_base_lidar=0 0 0.4 0 0 0"})
+    EXPECT_NE(crc_with({shapes}), base) << shapes;
+}
+
 TEST(NodeConfig, TheShippedExampleIsValid) {
   NodeConfig c;
   std::string error;
