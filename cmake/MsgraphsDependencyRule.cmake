@@ -45,7 +45,7 @@ set(_msgraphs_ext_runtime eigen fastdds os)
 set(_msgraphs_ext_test_support os gtest)
 set(_msgraphs_ext_tools eigen ceres fastdds os gpiod pcl)
 set(_msgraphs_ext_tests eigen ceres fastdds os gpiod pcl gtest benchmark)
-set(_msgraphs_ext_bench eigen ceres fastdds os gpiod gtest benchmark)
+set(_msgraphs_ext_bench eigen ceres fastdds os gpiod gtest benchmark zlib)
 
 # External classes that may only be linked PRIVATE (never part of a public interface).
 set(_msgraphs_private_only ceres)
@@ -71,6 +71,9 @@ function(_msgraphs_classify_external item out)
     set(class gtest)
   elseif(item MATCHES "^benchmark::")
     set(class benchmark)
+  elseif(item MATCHES "^ZLIB::ZLIB$")
+    # A peer in benchmarks only (bench/base_bench.cpp: CRC-32 against zlib's).
+    set(class zlib)
   endif()
   set(${out} "${class}" PARENT_SCOPE)
 endfunction()

@@ -126,6 +126,20 @@ TEST(Crc32, IsTheIeeeCrcAndNeverAllocates) {
   EXPECT_EQ(message_crc, expected);
 }
 
+// Eight bytes a step, then byte by byte: every length of tail and every start against the
+// 8-byte words gives the bit-by-bit CRC.
+TEST(Crc32, EveryTailAndEveryMisalignmentIsTheBitwiseCrc) {
+  std::vector<std::uint8_t> message(64);
+  for (std::size_t i = 0; i < message.size(); ++i) message[i] = static_cast<std::uint8_t>(i * 97 + 5);
+  const std::span<const std::uint8_t> all(message);
+  for (std::size_t start = 0; start < 8; ++start) {
+    for (std::size_t length = 0; start + length <= all.size(); ++length) {
+      const auto part = all.subspan(start, length);
+      ASSERT_EQ(Crc32(part), BitwiseCrc32(part)) << start << " " << length;
+    }
+  }
+}
+
 // A file's CRC taken over its parts (the checkpoint's snapshot: the mapper's bytes, then the
 // session's) is the CRC of the whole, wherever it is cut.
 TEST(Crc32, ContinuedOverPartsIsTheCrcOfTheWhole) {

@@ -187,6 +187,30 @@ TEST(LocalMapperSnapshot, BytesThatAreNotAWholeSnapshotAreRefusedAndChangeNothin
   for (std::size_t i = 0; i < 3; ++i) ASSERT_TRUE(FeedStep(third, bigger, walk, i, times));
   EXPECT_FALSE(third.Load(good));
   EXPECT_EQ(third.stats().keyframes, 3u);
+  // Sealed later (the node's SLAM thread copies, its writer thread seals): unsealed, the bytes
+  // are refused; sealed, they are the bytes sealed at once. Neither step allocates.
+  std::vector<std::uint8_t> later(mapper.SnapshotBytes());
+  std::uint64_t allocations = 0;
+  Expected<std::size_t> later_n = std::size_t{0};
+  {
+    test::AllocationScope scope;
+    later_n = mapper.Save(later, SnapshotSeal::kLater);
+    allocations = scope.allocations();
+  }
+  ASSERT_TRUE(later_n);
+  ASSERT_EQ(*later_n, good.size());
+  later.resize(*later_n);
+  EXPECT_NE(later, good);
+  refused(later);
+  {
+    test::AllocationScope scope;
+    EXPECT_TRUE(LocalMapper::SealSnapshot(later));
+    allocations += scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(later, good);
+  EXPECT_FALSE(LocalMapper::SealSnapshot(std::span(later).first(30)));
+  EXPECT_FALSE(LocalMapper::SealSnapshot(std::span(later).first(later.size() - 1)));
   // The good bytes load, and the mapper goes on.
   ASSERT_TRUE(other.Load(good));
   EXPECT_EQ(other.stats().keyframes, 20u);

@@ -7,10 +7,12 @@
 # after the resume (mapping again), how the resume went, the checkpoint folder's size, and the
 # first run's keyframe latency and peak RSS.
 #
-#   tools/eval/restart_eval.sh DURATION_S OUT_DIR [EVERY]      # EVERY: 50 (the default config)
+#   tools/eval/restart_eval.sh DURATION_S OUT_DIR [EVERY [MODES]]
+#   EVERY: 50 (the default config); MODES: both (the default) or generations (no journal-only run).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
-duration=${1:?duration in seconds}; out=${2:?output folder}; every=${3:-50}
+duration=${1:?duration in seconds}; out=${2:?output folder}; every=${3:-50}; modes=${4:-both}
+[[ $modes == both || $modes == generations ]] || { echo "MODES: both or generations" >&2; exit 2; }
 bin=${MSGRAPHS_BUILD_DIR:-build/host-release}
 mkdir -p "$out"; out=$(realpath "$out")
 run="$out/run"
@@ -69,4 +71,4 @@ one() {  # one() NAME EVERY
   awk -v a="$t0" -v b="$t1" 'BEGIN { printf "  restart: process start to mapping again %.1f s\n", b - a }'
 }
 one generations "$every"
-one journal_only 0
+[[ $modes == generations ]] || one journal_only 0

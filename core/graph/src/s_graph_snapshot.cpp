@@ -614,7 +614,9 @@ std::size_t SGraph::SnapshotBytes() const {
          c.max_planes * kPlane + c.max_rooms * kRoom + c.max_factors * (kFactor + 8) + 3 * 8;
 }
 
-Expected<std::size_t> SGraph::Save(std::span<std::uint8_t> out) const {
+Status SGraph::SealSnapshot(std::span<std::uint8_t> snapshot) { return SealSnapshotHeader(snapshot, kMagic); }
+
+Expected<std::size_t> SGraph::Save(std::span<std::uint8_t> out, SnapshotSeal seal) const {
   Impl& m = *impl_;
   if (!m.problem) return Error{Errc::kInvalidArgument, "s-graph not initialised"};
   // A full solve pending would change the graph when it is applied: its snapshot would hold a
@@ -639,8 +641,7 @@ Expected<std::size_t> SGraph::Save(std::span<std::uint8_t> out) const {
   IoList(w, m.free_factor_slots, m.factors.size());
   IoList(w, m.plane_only_factors, m.factors.size());
   if (w.failed()) return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
-  const std::span<const std::uint8_t> payload = out.subspan(kHeaderBytes, w.size());
-  return WriteSnapshotHeader(out, kMagic, kVersion, payload.size());
+  return WriteSnapshotHeader(out, kMagic, kVersion, w.size(), seal);
 }
 
 Status SGraph::Load(std::span<const std::uint8_t> in) {

@@ -49,15 +49,16 @@ void LocalMapper::ScheduleFullSolve(bool loop) {
 
 void LocalMapper::EndKeyframe() {
   if (snapshot_state_ == SnapshotState::kWanted && !full_job_.pending()) {
-    snapshot_result_ = Save(snapshot_out_);
+    snapshot_result_ = Save(snapshot_out_, snapshot_seal_);
     snapshot_state_ = SnapshotState::kTaken;
   }
   if (config_.full_solve_lag_keyframes > 0 && full_wanted_ && !full_job_.pending())
     BeginBackgroundSolve();
 }
 
-void LocalMapper::RequestSnapshot(std::span<std::uint8_t> out) {
+void LocalMapper::RequestSnapshot(std::span<std::uint8_t> out, SnapshotSeal seal) {
   snapshot_out_ = out;
+  snapshot_seal_ = seal;
   snapshot_state_ = SnapshotState::kWanted;
 }
 

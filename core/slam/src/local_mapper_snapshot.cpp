@@ -10,6 +10,7 @@
 //
 // Layout: magic, version, payload length, payload CRC-32; the payload holds the graph's
 // snapshot (with its own header and CRC) behind its length, then the parts.
+#include <algorithm>
 #include <cstring>
 
 #include "msgraphs/base/snapshot_archive.hpp"
@@ -118,13 +119,26 @@ std::size_t LocalMapper::SnapshotBytes() const {
          slots * (8 + 128) + (c.max_plane_priors + 2 * kLoopChecks) * 4 + kSlack;  // the mapper
 }
 
-Expected<std::size_t> LocalMapper::Save(std::span<std::uint8_t> out) const {
+Status LocalMapper::SealSnapshot(std::span<std::uint8_t> snapshot) {
+  // The graph's snapshot sits behind the mapper's header and its length; the mapper's CRC
+  // covers the graph's, so the graph's is written first.
+  std::uint64_t graph_bytes = 0;
+  SnapshotReader length(std::span<const std::uint8_t>(snapshot).subspan(std::min(snapshot.size(), kHeaderBytes)));
+  length(graph_bytes);
+  if (length.failed() || graph_bytes > snapshot.size() - kHeaderBytes - 8)
+    return Error{Errc::kInvalidArgument, "mapper snapshot: nothing to seal"};
+  if (Status s = SGraph::SealSnapshot(snapshot.subspan(kHeaderBytes + 8, static_cast<std::size_t>(graph_bytes))); !s)
+    return s;
+  return SealSnapshotHeader(snapshot, kMagic);
+}
+
+Expected<std::size_t> LocalMapper::Save(std::span<std::uint8_t> out, SnapshotSeal seal) const {
   if (full_job_.pending())
     return Error{Errc::kWouldBlock, "a background solve is pending: save after it is applied"};
   if (out.size() < kHeaderBytes + 8)
     return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
   // The graph's snapshot behind its length.
-  auto graph_bytes = graph_.Save(out.subspan(kHeaderBytes + 8));
+  auto graph_bytes = graph_.Save(out.subspan(kHeaderBytes + 8), seal);
   if (!graph_bytes) return graph_bytes.error();
   SnapshotWriter length(out.subspan(kHeaderBytes, 8));
   length(static_cast<std::uint64_t>(*graph_bytes));
@@ -140,8 +154,7 @@ Expected<std::size_t> LocalMapper::Save(std::span<std::uint8_t> out) const {
   fitness_gate_.Save(w);
   const_cast<LocalMapper*>(this)->Io(w);
   if (w.failed()) return Error{Errc::kCapacityExceeded, "snapshot buffer too small"};
-  const std::span<const std::uint8_t> payload = out.subspan(kHeaderBytes, 8 + *graph_bytes + w.size());
-  return WriteSnapshotHeader(out, kMagic, kVersion, payload.size());
+  return WriteSnapshotHeader(out, kMagic, kVersion, 8 + *graph_bytes + w.size(), seal);
 }
 
 Status LocalMapper::Load(std::span<const std::uint8_t> in) {

@@ -35,29 +35,31 @@ class SessionPart final : public core::CollabOutbox {
 
 }  // namespace
 
-void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
-  if (settings_.snapshot_every_keyframes == 0) return;
+bool Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
+  if (settings_.snapshot_every_keyframes == 0) return false;
   ++keyframes_since_;
   if (!requested_) {
     // One snapshot at a time: the next is asked for once the writer is done with the last.
     if (keyframes_since_ < settings_.snapshot_every_keyframes ||
         state_.load(std::memory_order_acquire) != State::kIdle)
-      return;
-    mapper.RequestSnapshot(std::span(file_.get() + kCheckpointHeadBytes, file_bytes_ - kCheckpointHeadBytes));
+      return false;
+    // Sealed later: the SLAM thread pays for the copy only, the writer thread for the CRCs.
+    mapper.RequestSnapshot(std::span(file_.get() + kCheckpointHeadBytes, file_bytes_ - kCheckpointHeadBytes),
+                           SnapshotSeal::kLater);
     requested_ = true;
     // The mapper may take it at this very keyframe's end only if asked before it: it is asked
     // now, for the next keyframe with no solve pending.
-    return;
+    return false;
   }
   auto taken = mapper.TakeSnapshot();
-  if (!taken) return;  // a solve was pending at this keyframe's end
+  if (!taken) return false;  // a solve was pending at this keyframe's end
   requested_ = false;
   keyframes_since_ = 0;
   if (!*taken) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stats_.snapshot_failures;
     stats_.last_failure = taken->error().detail;
-    return;
+    return true;
   }
   // The snapshot holds this keyframe, whose records went to the journal just before this call:
   // the next generation's journal begins after them.
@@ -67,7 +69,7 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stats_.snapshot_failures;
     stats_.last_failure = writer.error().detail;
-    return;
+    return true;
   }
   meta_ = CheckpointMeta{};
   meta_.robot = settings_.robot;
@@ -92,7 +94,7 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
       std::lock_guard<std::mutex> stats_lock(stats_mutex_);
       ++stats_.snapshot_failures;
       stats_.last_failure = "cannot write the new journal's first record";
-      return;
+      return true;
     }
     writer->TakeBuffersFrom(*journal_);
     const int old = journal_->DuplicateDescriptor();
@@ -111,6 +113,7 @@ void Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
     stats_.generation = next;
   }
   state_.store(State::kSession, std::memory_order_release);
+  return true;
 }
 
 void Checkpoint::CaptureSession(core::CollabSession& session) {
@@ -227,6 +230,9 @@ Status Checkpoint::WriteSnapshot() {
   }
   // The new journal's name: a snapshot never exists without its journal's entry.
   if (Status s = SyncFolder(settings_.dir); !s) return s;
+  // The mapper's CRCs, left by the SLAM thread (RequestSnapshot).
+  if (Status s = core::LocalMapper::SealSnapshot(std::span(file_.get() + kCheckpointHeadBytes, mapper_bytes_)); !s)
+    return s;
   // The file: head and mapper's bytes (file_), then the session's count and messages and the
   // CRC-32 of everything before it (session_).
   WriteCheckpointHead(meta_, mapper_bytes_,

@@ -73,6 +73,9 @@ struct SlamStatus {
   std::uint32_t walls = 0, rooms = 0;
   std::uint32_t graph_version = 0;  ///< the distilled version we have sent
   double keyframe_p50_ms = 0, keyframe_p99_ms = 0;
+  /// The keyframes whose end took a checkpoint snapshot (their latency holds the mapper's Save).
+  double snapshot_keyframe_p50_ms = 0, snapshot_keyframe_max_ms = 0;
+  std::uint64_t snapshot_keyframes = 0;
   double wire_p50_ms = 0, wire_p99_ms = 0, wire_max_ms = 0;  ///< last packet -> on the wire
   /// The SLAM thread's time in an exchange (priors, Prepare, the hand-over, the ROS view).
   double exchange_p50_ms = 0, exchange_p99_ms = 0, exchange_max_ms = 0;
@@ -121,6 +124,7 @@ struct Node::Impl {
   SolverWorker solver;  ///< runs the mapper's full solve (its own thread)
   SolverWorker marginals_solver;  ///< runs the distiller's wall marginals (its own thread)
   LatencyWindow keyframe_ms{4096};  ///< SLAM thread
+  LatencyWindow snapshot_keyframe_ms{256};  ///< SLAM thread: the keyframes that took a snapshot
   LatencyWindow wire_ms{4096};      ///< collab thread, under status_mutex
   std::vector<SteadyTime> unpublished_keyframes;  ///< last-packet times since the last Publish
   mutable std::mutex status_mutex;

@@ -238,11 +238,12 @@ void Node::Impl::PrintReport() {
     Appendf(text,
             "  checkpoint: generation %" PRIu64 " (newest durable snapshot %" PRIu64 "), %" PRIu64
             " snapshots written this run (last %.1f MB in %.2f s), %" PRIu64 " failed%s%s, %" PRIu64
-            " files removed, %" PRIu64 " journal write errors\n",
+            " files removed, %" PRIu64 " journal write errors; the %" PRIu64
+            " keyframes that took a snapshot %.1f ms p50, %.1f ms max on the SLAM thread\n",
             cs.generation, cs.durable_generation, cs.snapshots_written,
             static_cast<double>(cs.last_snapshot_bytes) / 1e6, cs.last_write_s, cs.snapshot_failures,
             cs.last_failure.empty() ? "" : ": ", cs.last_failure.c_str(), cs.files_removed,
-            cs.journal_errors);
+            cs.journal_errors, s.snapshot_keyframes, s.snapshot_keyframe_p50_ms, s.snapshot_keyframe_max_ms);
   }
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);

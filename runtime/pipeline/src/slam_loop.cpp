@@ -253,7 +253,8 @@ void Node::Impl::SlamLoop() {
     auto outcome = mapper.AddScan(view);
     const double end_s = scan->end_s;
     if (outcome && *outcome == core::ScanOutcome::kKeyframe) {
-      keyframe_ms.Add((platform::SteadyNow() - t0).seconds() * 1e3);
+      const double took_ms = (platform::SteadyNow() - t0).seconds() * 1e3;
+      keyframe_ms.Add(took_ms);
       solver.Offer(mapper.background_solve());  // a full solve begun at this keyframe
       // Only keyframes change the mapper's graph: only they are journaled, each with the motion
       // the sweeps before it tracked (replay makes the same keyframe from it).
@@ -265,7 +266,13 @@ void Node::Impl::SlamLoop() {
       });
       // After the keyframe's records: a snapshot the mapper took at its end begins the next
       // generation's journal here.
-      if (checkpoint) checkpoint->AfterKeyframe(mapper, view.end_s);
+      if (checkpoint && checkpoint->AfterKeyframe(mapper, view.end_s)) {
+        snapshot_keyframe_ms.Add(took_ms);
+        std::lock_guard<std::mutex> lock(status_mutex);
+        slam_status.snapshot_keyframe_p50_ms = snapshot_keyframe_ms.Percentile(0.5);
+        slam_status.snapshot_keyframe_max_ms = snapshot_keyframe_ms.Percentile(1.0);
+        slam_status.snapshot_keyframes = snapshot_keyframe_ms.count();
+      }
       if (unpublished_keyframes.size() < unpublished_keyframes.capacity())
         unpublished_keyframes.push_back(scan->last_packet);
     }

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 // A snapshot's header (the S-Graph's, the mapper's): magic (8 bytes), version u32, payload
 // length u64, CRC-32 of the payload, then the payload. Host byte order, as the archive.
+// The CRC may be left for later (SnapshotSeal::kLater) and written by SealSnapshotHeader on
+// another thread: a 52 MB snapshot's CRC is 15 ms that the thread that copied the state out
+// need not pay.
 #pragma once
 
 #include <array>
@@ -16,16 +19,40 @@ namespace msgraphs {
 constexpr std::size_t kSnapshotHeaderBytes = 8 + 4 + 8 + 4;
 using SnapshotMagic = std::array<std::uint8_t, 8>;
 
+/// kNow: the header carries the payload's CRC. kLater: a zero in its place until
+/// SealSnapshotHeader; such a snapshot does not load before it is sealed.
+enum class SnapshotSeal : std::uint8_t { kNow, kLater };
+
 /// Writes the header for the payload that follows it in `out`; returns the whole length.
 inline std::size_t WriteSnapshotHeader(std::span<std::uint8_t> out, const SnapshotMagic& magic,
-                                       std::uint32_t version, std::size_t payload_bytes) {
+                                       std::uint32_t version, std::size_t payload_bytes,
+                                       SnapshotSeal seal = SnapshotSeal::kNow) {
   const auto payload = std::span<const std::uint8_t>(out).subspan(kSnapshotHeaderBytes, payload_bytes);
   SnapshotWriter h(out.first(kSnapshotHeaderBytes));
   h(magic.data(), magic.size());
   h(version);
   h(static_cast<std::uint64_t>(payload.size()));
-  h(Crc32(payload));
+  h(seal == SnapshotSeal::kNow ? Crc32(payload) : std::uint32_t{0});
   return kSnapshotHeaderBytes + payload.size();
+}
+
+/// Writes the CRC of a snapshot written with SnapshotSeal::kLater (`snapshot`: its header and
+/// at least its payload, as Save returned them). kInvalidArgument, changing nothing, when the
+/// header is not `magic`'s or its payload runs past `snapshot`.
+inline Status SealSnapshotHeader(std::span<std::uint8_t> snapshot, const SnapshotMagic& magic) {
+  SnapshotReader h(snapshot);
+  SnapshotMagic read_magic{};
+  std::uint32_t version = 0;
+  std::uint64_t bytes = 0;
+  h(read_magic.data(), read_magic.size());
+  h(version);
+  h(bytes);
+  if (h.failed() || read_magic != magic || bytes > snapshot.size() - kSnapshotHeaderBytes)
+    return Error{Errc::kInvalidArgument, "snapshot: nothing to seal"};
+  const auto payload = std::span<const std::uint8_t>(snapshot).subspan(kSnapshotHeaderBytes, bytes);
+  SnapshotWriter crc(snapshot.subspan(kSnapshotHeaderBytes - 4, 4));
+  crc(Crc32(payload));
+  return Ok();
 }
 
 /// The payload of a whole snapshot of this kind and version; kInvalidArgument otherwise.

@@ -34,6 +34,7 @@
 #include <span>
 
 #include "msgraphs/base/expected.hpp"
+#include "msgraphs/base/snapshot_header.hpp"
 
 namespace msgraphs::core {
 
@@ -296,8 +297,12 @@ class SGraph {
   /// Loaded into a graph initialised with the same config, it goes on bit for bit as this one
   /// would. kWouldBlock while a full solve is pending (a job that only borrows the costs, such
   /// as the marginals, does not stop it: both only read); kCapacityExceeded when `out` is too
-  /// small (SnapshotBytes always suffices). Allocates nothing.
-  Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
+  /// small (SnapshotBytes always suffices). `seal` kLater leaves the CRC to SealSnapshot (on
+  /// another thread, say). Allocates nothing.
+  Expected<std::size_t> Save(std::span<std::uint8_t> out, SnapshotSeal seal = SnapshotSeal::kNow) const;
+  /// Writes the CRC of a snapshot Save wrote with SnapshotSeal::kLater (`snapshot`: the bytes
+  /// Save returned). kInvalidArgument when they are not a graph snapshot's.
+  static Status SealSnapshot(std::span<std::uint8_t> snapshot);
   /// Replaces this graph by a snapshot. kInvalidArgument, with the graph unchanged, for bytes
   /// that are not a whole snapshot of this version (CRC-32 checked) or that were made with
   /// another config; a snapshot whose records do not hold together (links, free lists, counts,

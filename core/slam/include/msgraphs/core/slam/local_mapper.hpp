@@ -34,6 +34,7 @@
 
 #include "msgraphs/base/bounded_vector.hpp"
 #include "msgraphs/base/expected.hpp"
+#include "msgraphs/base/snapshot_header.hpp"
 #include "msgraphs/core/graph/s_graph.hpp"
 #include "msgraphs/core/graph/s_graph_solve_job.hpp"
 #include "msgraphs/core/perception/covariances.hpp"
@@ -350,8 +351,14 @@ class LocalMapper {
   /// is the caller's to keep the same (the node: its config file's CRC). kWouldBlock while a
   /// background full solve is pending or any job borrows the graph, such as the distiller's
   /// marginals (save after it ended); kCapacityExceeded when `out` is too small
-  /// (SnapshotBytes always suffices). Allocates nothing.
-  Expected<std::size_t> Save(std::span<std::uint8_t> out) const;
+  /// (SnapshotBytes always suffices). `seal` kLater leaves the CRCs to SealSnapshot: the copy
+  /// is then all the caller's thread pays (docs/performance.md, "Restart after a long
+  /// mission"). Allocates nothing.
+  Expected<std::size_t> Save(std::span<std::uint8_t> out, SnapshotSeal seal = SnapshotSeal::kNow) const;
+  /// Writes the CRCs (the graph's, then the mapper's) of a snapshot Save wrote with
+  /// SnapshotSeal::kLater (`snapshot`: the bytes Save returned); any thread may, the mapper is
+  /// not touched. kInvalidArgument when they are not a mapper snapshot's. Allocates nothing.
+  static Status SealSnapshot(std::span<std::uint8_t> snapshot);
   /// Replaces this mapper's state by a snapshot. kInvalidArgument with the mapper unchanged for
   /// bytes that are not a whole snapshot of this version (CRC-32) or whose graph has another
   /// config; one whose parts do not fit this mapper's stores or do not hold together leaves it
@@ -362,8 +369,9 @@ class LocalMapper {
   /// begins, so the state it holds is whole. Saving between scans instead would almost never
   /// find that moment with full_solve_lag_keyframes > 0 (a solve is pending for most
   /// keyframes). `out` must stay valid until the result is taken; SnapshotBytes() suffices. A
-  /// new request replaces one not yet served; Init and Load forget it. Allocates nothing.
-  void RequestSnapshot(std::span<std::uint8_t> out);
+  /// new request replaces one not yet served; Init and Load forget it. `seal` as for Save.
+  /// Allocates nothing.
+  void RequestSnapshot(std::span<std::uint8_t> out, SnapshotSeal seal = SnapshotSeal::kNow);
   /// The snapshot taken for the last request (its size in `out`, or why Save refused), once;
   /// nothing while it still waits for its keyframe.
   std::optional<Expected<std::size_t>> TakeSnapshot();
@@ -527,6 +535,7 @@ class LocalMapper {
   enum class SnapshotState : std::uint8_t { kNone, kWanted, kTaken };
   SnapshotState snapshot_state_ = SnapshotState::kNone;
   std::span<std::uint8_t> snapshot_out_;
+  SnapshotSeal snapshot_seal_ = SnapshotSeal::kNow;
   Expected<std::size_t> snapshot_result_ = std::size_t{0};
   LocalMapperStats stats_;
 };
