@@ -126,8 +126,8 @@ TEST(Crc32, IsTheIeeeCrcAndNeverAllocates) {
   EXPECT_EQ(message_crc, expected);
 }
 
-// Eight bytes a step, then byte by byte: every length of tail and every start against the
-// 8-byte words gives the bit-by-bit CRC.
+// 16 bytes a step, then byte by byte: every length of tail and every start against the
+// words gives the bit-by-bit CRC.
 TEST(Crc32, EveryTailAndEveryMisalignmentIsTheBitwiseCrc) {
   std::vector<std::uint8_t> message(64);
   for (std::size_t i = 0; i < message.size(); ++i) message[i] = static_cast<std::uint8_t>(i * 97 + 5);

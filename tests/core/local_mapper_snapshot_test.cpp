@@ -209,8 +209,22 @@ TEST(LocalMapperSnapshot, BytesThatAreNotAWholeSnapshotAreRefusedAndChangeNothin
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_EQ(later, good);
-  EXPECT_FALSE(LocalMapper::SealSnapshot(std::span(later).first(30)));
-  EXPECT_FALSE(LocalMapper::SealSnapshot(std::span(later).first(later.size() - 1)));
+  // Bytes that are not a whole mapper snapshot are refused and left as they were: cut short
+  // (within the header, or anywhere after it), or a graph length too short for the graph's own
+  // header (20-23 bytes hold its magic and length but not its CRC).
+  const auto refused_seal = [](std::vector<std::uint8_t> bytes) {
+    const std::vector<std::uint8_t> before = bytes;
+    EXPECT_FALSE(LocalMapper::SealSnapshot(bytes)) << bytes.size();
+    EXPECT_EQ(bytes, before);
+  };
+  for (std::size_t cut : {std::size_t{0}, std::size_t{20}, std::size_t{22}, std::size_t{30}, later.size() - 1})
+    refused_seal(std::vector<std::uint8_t>(later.begin(), later.begin() + static_cast<std::ptrdiff_t>(cut)));
+  for (std::uint64_t graph_bytes : {std::uint64_t{20}, std::uint64_t{23}, std::uint64_t{later.size()}}) {
+    std::vector<std::uint8_t> bad = later;
+    bad[kSnapshotHeaderBytes - 1] ^= 0x5A;  // unsealed again, so a refusal that wrote shows
+    std::memcpy(bad.data() + kSnapshotHeaderBytes, &graph_bytes, sizeof graph_bytes);
+    refused_seal(bad);
+  }
   // The good bytes load, and the mapper goes on.
   ASSERT_TRUE(other.Load(good));
   EXPECT_EQ(other.stats().keyframes, 20u);

@@ -10,7 +10,6 @@
 //
 // Layout: magic, version, payload length, payload CRC-32; the payload holds the graph's
 // snapshot (with its own header and CRC) behind its length, then the parts.
-#include <algorithm>
 #include <cstring>
 
 #include "msgraphs/base/snapshot_archive.hpp"
@@ -121,14 +120,16 @@ std::size_t LocalMapper::SnapshotBytes() const {
 
 Status LocalMapper::SealSnapshot(std::span<std::uint8_t> snapshot) {
   // The graph's snapshot sits behind the mapper's header and its length; the mapper's CRC
-  // covers the graph's, so the graph's is written first.
+  // covers the graph's, so the graph's is written first. Everything is checked before either.
+  auto payload_bytes = SnapshotPayloadBytes(snapshot, kMagic);
+  if (!payload_bytes) return payload_bytes.error();
+  const auto payload = snapshot.subspan(kHeaderBytes, *payload_bytes);
   std::uint64_t graph_bytes = 0;
-  SnapshotReader length(std::span<const std::uint8_t>(snapshot).subspan(std::min(snapshot.size(), kHeaderBytes)));
+  SnapshotReader length(payload);
   length(graph_bytes);
-  if (length.failed() || graph_bytes > snapshot.size() - kHeaderBytes - 8)
-    return Error{Errc::kInvalidArgument, "mapper snapshot: nothing to seal"};
-  if (Status s = SGraph::SealSnapshot(snapshot.subspan(kHeaderBytes + 8, static_cast<std::size_t>(graph_bytes))); !s)
-    return s;
+  if (length.failed() || graph_bytes > payload.size() - 8)
+    return Error{Errc::kInvalidArgument, "mapper snapshot: the graph's length runs past its end"};
+  if (Status s = SGraph::SealSnapshot(payload.subspan(8, static_cast<std::size_t>(graph_bytes))); !s) return s;
   return SealSnapshotHeader(snapshot, kMagic);
 }
 

@@ -59,7 +59,7 @@ bool Checkpoint::AfterKeyframe(core::LocalMapper& mapper, double scan_end_s) {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stats_.snapshot_failures;
     stats_.last_failure = taken->error().detail;
-    return true;
+    return false;  // no snapshot: nothing of Save in this keyframe's latency to report
   }
   // The snapshot holds this keyframe, whose records went to the journal just before this call:
   // the next generation's journal begins after them.

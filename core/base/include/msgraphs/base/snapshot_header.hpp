@@ -20,7 +20,7 @@ constexpr std::size_t kSnapshotHeaderBytes = 8 + 4 + 8 + 4;
 using SnapshotMagic = std::array<std::uint8_t, 8>;
 
 /// kNow: the header carries the payload's CRC. kLater: a zero in its place until
-/// SealSnapshotHeader; such a snapshot does not load before it is sealed.
+/// SealSnapshotHeader; until then a load refuses it as any snapshot whose CRC does not check.
 enum class SnapshotSeal : std::uint8_t { kNow, kLater };
 
 /// Writes the header for the payload that follows it in `out`; returns the whole length.
@@ -36,20 +36,29 @@ inline std::size_t WriteSnapshotHeader(std::span<std::uint8_t> out, const Snapsh
   return kSnapshotHeaderBytes + payload.size();
 }
 
-/// Writes the CRC of a snapshot written with SnapshotSeal::kLater (`snapshot`: its header and
-/// at least its payload, as Save returned them). kInvalidArgument, changing nothing, when the
-/// header is not `magic`'s or its payload runs past `snapshot`.
-inline Status SealSnapshotHeader(std::span<std::uint8_t> snapshot, const SnapshotMagic& magic) {
+/// The payload length a header of `magic`'s kind gives, when the header and that payload are
+/// within `snapshot`; kInvalidArgument otherwise. Reads only.
+inline Expected<std::size_t> SnapshotPayloadBytes(std::span<const std::uint8_t> snapshot, const SnapshotMagic& magic) {
   SnapshotReader h(snapshot);
   SnapshotMagic read_magic{};
-  std::uint32_t version = 0;
+  std::uint32_t version = 0, crc = 0;
   std::uint64_t bytes = 0;
   h(read_magic.data(), read_magic.size());
   h(version);
   h(bytes);
+  h(crc);  // the whole header is within `snapshot`: the size test below cannot wrap
   if (h.failed() || read_magic != magic || bytes > snapshot.size() - kSnapshotHeaderBytes)
-    return Error{Errc::kInvalidArgument, "snapshot: nothing to seal"};
-  const auto payload = std::span<const std::uint8_t>(snapshot).subspan(kSnapshotHeaderBytes, bytes);
+    return Error{Errc::kInvalidArgument, "snapshot: not a whole snapshot of this kind"};
+  return static_cast<std::size_t>(bytes);
+}
+
+/// Writes the CRC of a snapshot written with SnapshotSeal::kLater (`snapshot`: its header and
+/// at least its payload, as Save returned them). kInvalidArgument, changing nothing, when the
+/// header is not `magic`'s or its payload runs past `snapshot`.
+inline Status SealSnapshotHeader(std::span<std::uint8_t> snapshot, const SnapshotMagic& magic) {
+  auto bytes = SnapshotPayloadBytes(snapshot, magic);
+  if (!bytes) return bytes.error();
+  const auto payload = std::span<const std::uint8_t>(snapshot).subspan(kSnapshotHeaderBytes, *bytes);
   SnapshotWriter crc(snapshot.subspan(kSnapshotHeaderBytes - 4, 4));
   crc(Crc32(payload));
   return Ok();

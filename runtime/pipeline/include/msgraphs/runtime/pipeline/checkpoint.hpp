@@ -121,7 +121,8 @@ class Checkpoint {
   void Sync(bool final = false);
   /// SLAM thread, after each keyframe's records: asks for a snapshot when one is due, and
   /// switches the journal once the mapper took it. `scan_end_s` is that keyframe's scan end.
-  /// True when this keyframe's end took a snapshot (its latency holds the mapper's Save).
+  /// True when this keyframe's end took a snapshot (its latency holds the mapper's Save), even
+  /// if the journal's switch then failed; false when the mapper refused it.
   bool AfterKeyframe(core::LocalMapper& mapper, double scan_end_s);
   /// Whether CaptureSession has work (cheap: the collab thread asks before locking).
   bool session_wanted() const { return state_.load(std::memory_order_acquire) == State::kSession; }
