@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 #include "msgraphs/base/crc32.hpp"
@@ -36,20 +37,35 @@ inline std::size_t WriteSnapshotHeader(std::span<std::uint8_t> out, const Snapsh
   return kSnapshotHeaderBytes + payload.size();
 }
 
+namespace detail {
+struct SnapshotHeaderFields {
+  SnapshotMagic magic{};
+  std::uint32_t version = 0;
+  std::uint64_t payload_bytes = 0;
+  std::uint32_t crc = 0;
+};
+
+/// The header's fields when the whole header is within `in`; nullopt otherwise. After it,
+/// `in.size() - kSnapshotHeaderBytes` cannot wrap.
+inline std::optional<SnapshotHeaderFields> ReadSnapshotHeader(std::span<const std::uint8_t> in) {
+  SnapshotReader h(in);
+  SnapshotHeaderFields f;
+  h(f.magic.data(), f.magic.size());
+  h(f.version);
+  h(f.payload_bytes);
+  h(f.crc);
+  if (h.failed()) return std::nullopt;
+  return f;
+}
+}  // namespace detail
+
 /// The payload length a header of `magic`'s kind gives, when the header and that payload are
 /// within `snapshot`; kInvalidArgument otherwise. Reads only.
 inline Expected<std::size_t> SnapshotPayloadBytes(std::span<const std::uint8_t> snapshot, const SnapshotMagic& magic) {
-  SnapshotReader h(snapshot);
-  SnapshotMagic read_magic{};
-  std::uint32_t version = 0, crc = 0;
-  std::uint64_t bytes = 0;
-  h(read_magic.data(), read_magic.size());
-  h(version);
-  h(bytes);
-  h(crc);  // the whole header is within `snapshot`: the size test below cannot wrap
-  if (h.failed() || read_magic != magic || bytes > snapshot.size() - kSnapshotHeaderBytes)
+  const auto f = detail::ReadSnapshotHeader(snapshot);
+  if (!f || f->magic != magic || f->payload_bytes > snapshot.size() - kSnapshotHeaderBytes)
     return Error{Errc::kInvalidArgument, "snapshot: not a whole snapshot of this kind"};
-  return static_cast<std::size_t>(bytes);
+  return static_cast<std::size_t>(f->payload_bytes);
 }
 
 /// Writes the CRC of a snapshot written with SnapshotSeal::kLater (`snapshot`: its header and
@@ -68,20 +84,13 @@ inline Status SealSnapshotHeader(std::span<std::uint8_t> snapshot, const Snapsho
 inline Expected<std::span<const std::uint8_t>> SnapshotPayload(std::span<const std::uint8_t> in,
                                                                const SnapshotMagic& magic,
                                                                std::uint32_t version) {
-  SnapshotReader h(in);
-  SnapshotMagic read_magic{};
-  std::uint32_t read_version = 0, crc = 0;
-  std::uint64_t bytes = 0;
-  h(read_magic.data(), read_magic.size());
-  h(read_version);
-  h(bytes);
-  h(crc);
-  if (h.failed() || read_magic != magic) return Error{Errc::kInvalidArgument, "snapshot: not one of this kind"};
-  if (read_version != version) return Error{Errc::kInvalidArgument, "snapshot: another version"};
-  if (bytes != in.size() - kSnapshotHeaderBytes)
+  const auto f = detail::ReadSnapshotHeader(in);
+  if (!f || f->magic != magic) return Error{Errc::kInvalidArgument, "snapshot: not one of this kind"};
+  if (f->version != version) return Error{Errc::kInvalidArgument, "snapshot: another version"};
+  if (f->payload_bytes != in.size() - kSnapshotHeaderBytes)
     return Error{Errc::kInvalidArgument, "snapshot: truncated or overlong"};
   const std::span<const std::uint8_t> payload = in.subspan(kSnapshotHeaderBytes);
-  if (Crc32(payload) != crc) return Error{Errc::kInvalidArgument, "snapshot: CRC mismatch"};
+  if (Crc32(payload) != f->crc) return Error{Errc::kInvalidArgument, "snapshot: CRC mismatch"};
   return payload;
 }
 
