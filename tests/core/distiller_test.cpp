@@ -118,6 +118,7 @@ TEST(Distiller, HoldsBackAWallNothingMeasuresAnyMore) {
   OneRoom f;
   f.config.max_keyframes = 8;
   f.config.local_window_keyframes = 2;
+  f.config.sparsify_plane_share = 0;  // observations dropped with their keyframe, not carried
   f.step_m = 0.25;  // 12 keyframes inside the room
   ASSERT_TRUE(f.graph.Init(f.config));
   // Every keyframe also sees a wall of its own (parallel to wall 0, further out), so a full

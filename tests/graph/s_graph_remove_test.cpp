@@ -181,16 +181,25 @@ TEST(SGraphRemoveKeyframe, NeverFusesIntoAKeptLoop) {
   }
 }
 
-// Plane observations go with their keyframe (they are never carried). A plane whose every
-// observer went would stay in the problem unmeasured, where Ceres gives it a zero covariance:
-// a removal on request never takes a plane's last observer, and its marginal is refused.
+// With carrying off (sparsify_plane_share 0) plane observations go with their keyframe. A plane
+// whose every observer went would stay in the problem unmeasured, where Ceres gives it a zero
+// covariance: a removal on request never takes a plane's last observer, and its marginal is
+// refused. With carrying on (the default) the last observer goes like any other keyframe and
+// its observation goes to a neighbour.
+SGraphConfig DroppingStore() {
+  SGraphConfig config = SmallStore();
+  config.sparsify_plane_share = 0;
+  return config;
+}
+
 class SGraphPlaneObservers : public ::testing::Test {
  protected:
+  SGraphConfig config = DroppingStore();
   // StraightLine's line, as far as a store of 16 lets it grow; every keyframe sees wall
   // `seen_by_all` when added; keyframe `only` alone sees wall `seen_once` (`times` times: two
   // segments of one wall in one scan are two observations). ids[i]: keyframe i's.
   void Build(std::uint32_t count, std::uint32_t only, int times = 1) {
-    ASSERT_TRUE(g.Init(SmallStore()));
+    ASSERT_TRUE(g.Init(config));
     seen_by_all = *g.AddPlane(all.n, all.d, PlaneClass::kWall);
     seen_once = *g.AddPlane(once.n, once.d, PlaneClass::kWall);
     Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
@@ -252,7 +261,7 @@ TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverAfterTheOthersOfIts
   // 5 sees no wall but closes a loop to the origin: a loop weighs more than a wall seen once,
   // so it stays while walls' only observers go.
   SGraph h;
-  ASSERT_TRUE(h.Init(SmallStore()));
+  ASSERT_TRUE(h.Init(DroppingStore()));
   std::vector<std::uint32_t> walls;
   std::vector<double> offsets_m;
   std::uint32_t prev = 0;
@@ -307,6 +316,37 @@ TEST_F(SGraphPlaneObservers, SparsificationTakesALastObserverAfterTheOthersOfIts
   std::array<Eigen::Matrix3d, 1> covariance{};
   ASSERT_TRUE(h.PlaneMarginals(newest, covariance));  // the observed ones still have one
   EXPECT_GT(covariance[0].diagonal().minCoeff(), 1e-8);
+}
+
+TEST_F(SGraphPlaneObservers, CarriedTheLastObserverGoesAndItsWallStaysMeasured) {
+  config = SmallStore();
+  ASSERT_NO_FATAL_FAILURE(Build(7, 2));
+  ASSERT_TRUE(g.RemoveKeyframe(2));
+  EXPECT_EQ(g.plane(seen_once).live_observations, 1u);  // now a neighbour's
+  EXPECT_EQ(g.plane(seen_by_all).live_observations, 6u);  // 2's fused into the neighbour's
+  EXPECT_EQ(g.stats().sparsify_planes_carried, 2u);
+  EXPECT_EQ(g.stats().sparsify_planes_fused, 1u);
+  EXPECT_EQ(g.stats().planes_unobserved, 0u);
+  const std::array<std::uint32_t, 2> both{seen_by_all, seen_once};
+  std::array<Eigen::Matrix3d, 2> covariances{};
+  ASSERT_TRUE(g.PlaneMarginals(both, covariances));
+  for (const Eigen::Matrix3d& c : covariances) EXPECT_GT(c.diagonal().minCoeff(), 1e-8);
+}
+
+TEST_F(SGraphPlaneObservers, CarriedSparsificationTakesALastObserverLikeAnyOther) {
+  // 40 keyframes through a store of 16: keyframe 1, the only one to see `seen_once` (twice),
+  // is not held back as its last observer: it goes in its turn like any other, and the wall
+  // stays measured through its carried observations.
+  config = SmallStore();
+  ASSERT_NO_FATAL_FAILURE(Build(40, 1, 2));
+  EXPECT_FALSE(g.keyframe_active(ids[1]) && g.keyframe_stamp(ids[1]) == 1.0);
+  EXPECT_GT(g.stats().sparsified, 20u);
+  EXPECT_EQ(g.stats().planes_unobserved, 0u);
+  EXPECT_GE(g.plane(seen_once).live_observations, 1u);
+  EXPECT_EQ(g.stats().sparsify_planes_dropped, 0u);
+  EXPECT_TRUE(g.Solve(SolveKind::kFull));
+  EXPECT_NEAR(g.plane(seen_once).d, once.d, 0.05);
+  EXPECT_NEAR(g.plane(seen_by_all).d, all.d, 0.05);
 }
 
 }  // namespace

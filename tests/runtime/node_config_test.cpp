@@ -153,7 +153,7 @@ TEST(NodeConfig, TheMapperSettingsCrcFollowsWhatShapesTheMapOnly) {
        {"mapping.keyframe_spacing_m=0.7", "mapping.max_range_m=30", "mapping.max_keyframes=2000",
         "mapping.cloud_store_points=2000000", "mapping.full_solve_lag_keyframes=2",
         "mapping.grid_half_extent_m=60", "mapping.track_scans=false",
-        "rooms.door_cut_clearance_m=0.6", "odometry.sigma_per_m=0.05",
+        "mapping.sparsify_plane_share=0.2", "rooms.door_cut_clearance_m=0.6", "odometry.sigma_per_m=0.05",
         "lidar.T_base_lidar=0 0 0.4 0 0 0"})
     EXPECT_NE(crc_with({shapes}), base) << shapes;
 }

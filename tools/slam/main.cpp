@@ -18,6 +18,7 @@
 // either way).
 //
 //   msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] [--max-keyframes N]
+//                 [--sparsify-plane-share S]
 //                 [--matches FILE] [--fitness-floor M2] [--fitness-outlier-z Z]
 //                 [--odometry-from-truth] [--speed X]
 #include <sys/resource.h>
@@ -87,6 +88,7 @@ int main(int argc, char** argv) {
   int robot = 1;
   bool markdown = false, verbose = false, odometry_from_truth = false;
   std::size_t max_keyframes = 0;
+  double plane_share = -1;
   long full_solve_lag = -1;
   std::string matches_path;
   double fitness_floor_m2 = -1, fitness_outlier_z = -1;
@@ -101,6 +103,15 @@ int main(int argc, char** argv) {
       out_dir = argv[++i];
     else if (a == "--max-keyframes" && i + 1 < argc)
       max_keyframes = static_cast<std::size_t>(std::atol(argv[++i]));
+    else if (a == "--sparsify-plane-share" && i + 1 < argc) {
+      // Strict: a typo must not turn carrying off (atof's 0); the range is the config's.
+      char* end = nullptr;
+      plane_share = std::strtod(argv[++i], &end);
+      if (end == argv[i] || *end != '\0' || !(plane_share >= 0 && plane_share < 1)) {
+        std::fprintf(stderr, "--sparsify-plane-share: a number at least 0 and below 1, not '%s'\n", argv[i]);
+        return 2;
+      }
+    }
     else if (a == "--full-solve-lag" && i + 1 < argc)
       full_solve_lag = std::atol(argv[++i]);
     else if (a == "--matches" && i + 1 < argc)
@@ -120,7 +131,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: msgraphs_slam --run DIR --robot N [--out DIR] [--markdown] [--verbose] "
-                   "[--max-keyframes N] [--full-solve-lag N] [--matches FILE] [--fitness-floor M2] "
+                   "[--max-keyframes N] [--sparsify-plane-share S] [--full-solve-lag N] [--matches FILE] [--fitness-floor M2] "
                    "[--fitness-outlier-z Z] [--odometry-from-truth] [--speed X]\n");
       return 2;
     }
@@ -136,6 +147,7 @@ int main(int argc, char** argv) {
   }
   core::LocalMapperConfig config;
   if (max_keyframes > 0) config.graph.max_keyframes = max_keyframes;
+  if (plane_share >= 0) config.graph.sparsify_plane_share = plane_share;
   if (full_solve_lag >= 0) config.full_solve_lag_keyframes = static_cast<std::size_t>(full_solve_lag);
   if (fitness_floor_m2 >= 0) config.scan_match_max_fitness_m2 = fitness_floor_m2;
   if (fitness_outlier_z >= 0) config.scan_match_fitness_outlier_z = fitness_outlier_z;
@@ -375,9 +387,11 @@ int main(int argc, char** argv) {
       gs.floor_factors);
   std::printf(
       "sparsification: %zu of them carrying loops, %zu loops carried to a neighbour (%zu fused "
-      "with one there), %zu constraints dropped; keyframes refused %llu (mapper %llu), odometry "
-      "or scan-matching factors refused %llu\n",
+      "with one there), %zu constraints dropped; plane observations %zu carried (%zu fused), %zu "
+      "dropped; keyframes refused %llu (mapper %llu), odometry or scan-matching factors refused "
+      "%llu\n",
       gs.sparsified_with_loops, gs.sparsify_carried, gs.sparsify_merged, gs.sparsify_dropped,
+      gs.sparsify_planes_carried, gs.sparsify_planes_fused, gs.sparsify_planes_dropped,
       static_cast<unsigned long long>(gs.rejected_keyframes),
       static_cast<unsigned long long>(ms.keyframes_refused),
       static_cast<unsigned long long>(ms.chain_factors_refused));

@@ -35,6 +35,9 @@ Status SGraphConfig::Validate() const {
   if (local_window_keyframes < 2 || local_window_keyframes >= max_keyframes) {
     return Error{Errc::kInvalidConfig, "s-graph local window must be >= 2 and below max_keyframes"};
   }
+  if (!(sparsify_plane_share >= 0 && sparsify_plane_share < 1)) {
+    return Error{Errc::kInvalidConfig, "s-graph sparsify_plane_share must be in [0, 1)"};
+  }
   if (local_max_iterations < 1 || full_max_iterations < 1 || !(local_max_seconds > 0) ||
       !(full_max_seconds > 0)) {
     return Error{Errc::kInvalidConfig, "s-graph solve limits must be positive"};
@@ -294,16 +297,8 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
     ++m.stats.rejected_behind;
     return Error{Errc::kInvalidArgument, "plane seen from behind"};
   }
-  auto slot = m.NewFactor(FactorKind::kPlane, keyframe, plane);
-  if (!slot) return slot.error();
-  // An observation by a keyframe the plane's held sum already covers: the sum is taken afresh.
-  if (m.keyframes[keyframe].stamp_s < p.held_before_s) p.held_epoch = 0;
-  m.EnsurePlaneInProblem(p);
-  auto* functor = new sgraph::PlaneResidual{z.basis_u, z.basis_v, z.d, sqrt_information};
-  auto* cost = new sgraph::PlaneCost(functor);
-  KeyframeNode& k = m.keyframes[keyframe];
-  m.Bind(*slot, m.problem->AddResidualBlock(cost, m.huber_plane.get(), k.q, k.t, p.n, p.d));
-  ++m.stats.plane_factors;
+  if (auto slot = m.AddPlaneFactor(keyframe, plane, {z.basis_u, z.basis_v, z.d, sqrt_information}); !slot)
+    return slot.error();
   // Information of this observation about the map plane: the Jacobian of the measurement
   // coordinates (u_m.n_k, v_m.n_k, d_k) with respect to the map plane's (alpha, beta, delta_d),
   // n_k = R^T n and d_k = d + n.t, at the keyframe's current estimate.
@@ -314,7 +309,6 @@ Status SGraph::AddPlaneObservation(std::uint32_t keyframe,
       p.info.basis_u.dot(T.translation()), p.info.basis_v.dot(T.translation()), 1;
   p.info.information += J.transpose() * information * J;
   ++p.info.observations;
-  ++p.info.live_observations;
   // The newest observer (the local solve frees a plane its window sees): an observation by an
   // older keyframe does not move it back.
   p.info.last_observed_s = std::max(p.info.last_observed_s, m.keyframes[keyframe].stamp_s);

@@ -522,6 +522,23 @@ struct SGraph::Impl {
   // body of Sparsify once the victim is chosen; counts what it carries and drops, not itself.
   // Factors in `keep_factors` stay as they are (a carried loop is never fused into one).
   void RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t> keep_factors = {});
+  // Carries plane observation `slot` (on keyframe v) to keyframe t: the measurement as t would
+  // have made it, T_t_v its pose in t's frame and hop_covariance the covariance of T_t_v's
+  // right perturbation [translation; rotation], already inflated for the hop's other uses.
+  // Fused into t's own observation of the plane when t has one that agrees with it. v's factor
+  // is removed either way; false (the observation is lost) when the covariances are not
+  // positive definite or the factor store refuses it (s_graph_sparsify_planes.cpp).
+  bool CarryPlaneObservation(std::int32_t slot,
+                             std::uint32_t t,
+                             const Eigen::Isometry3d& T_t_v,
+                             const Matrix6d& hop_covariance,
+                             bool& fused);
+  // A keyframe-to-plane factor from its measurement in the residual's terms (basis, offset,
+  // upper root of the information), without AddPlaneObservation's checks and bookkeeping of
+  // new evidence: what sparsification puts back.
+  Expected<std::int32_t> AddPlaneFactor(std::uint32_t keyframe,
+                                        std::uint32_t plane,
+                                        const sgraph::PlaneResidual& z);
   // Whether removing v would carry every loop on it and join its neighbours, and leave every
   // plane it sees observed (no constraint dropped): what a removal on request requires.
   bool RemovalLosesNothing(std::uint32_t v);

@@ -30,13 +30,13 @@ namespace msgraphs::core {
 namespace {
 
 constexpr SnapshotMagic kMagic{'M', 'S', 'G', 'S', 'G', 'R', 'P', 'H'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: sparsify_plane_share and its counters
 constexpr std::size_t kHeaderBytes = kSnapshotHeaderBytes;
 constexpr std::size_t kMaxBlocks = 9;   // a four-wall room: centre and four walls' two blocks
 constexpr std::size_t kMaxValues = 43;  // a relative pose: rotation, translation, 6x6 root
 
 // A new field in one of these must be added to its visitor below, then the size here.
-static_assert(sizeof(void*) != 8 || sizeof(SGraphConfig) == 128, "SGraphConfig changed: see Io");
+static_assert(sizeof(void*) != 8 || sizeof(SGraphConfig) == 144, "SGraphConfig changed: see Io");
 static_assert(sizeof(void*) != 8 || sizeof(MapPlane) == 184, "MapPlane changed: see Io");
 static_assert(sizeof(void*) != 8 || sizeof(MapRoom) == 80, "MapRoom changed: see Io");
 static_assert(std::is_trivially_copyable_v<SGraphStats>, "SGraphStats is saved whole");
@@ -71,6 +71,7 @@ void Io(Ar& ar, SGraphConfig& c) {
   ar(c.local_max_iterations);
   ar(c.local_max_seconds);
   IoBool(ar, c.incremental_held_sums);
+  ar(c.sparsify_plane_share);
   ar(c.full_max_iterations);
   ar(c.full_max_seconds);
 }

@@ -4,9 +4,12 @@
 //
 // The victim's neighbours p and n are joined by the composition of its two chain hops, and every
 // other relative factor on it (a loop closure) is carried to a neighbour through the hop that
-// leads there. A hop shared by k composed factors enters each with k times its covariance
-// (covariance intersection with equal weights): the factors are then never jointly more certain
-// than the one measurement they share, whatever its correlation with itself.
+// leads there, and so is every plane observation on it (s_graph_sparsify_planes.cpp). A hop
+// shared by several carried factors enters each with its covariance divided by that factor's
+// weight, the weights summing to one (covariance intersection): the factors are then never
+// jointly more certain than the one measurement they share, whatever its correlation with
+// itself. The plane observations get sparsify_plane_share of it together, the composed chain
+// and the loops the rest, in equal parts within each group.
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -39,8 +42,19 @@ struct Hop {
   Matrix6d covariance = Matrix6d::Zero();
   double log_det_information = -std::numeric_limits<double>::infinity();
   bool usable = false;
-  double uses = 0;  // composed factors that rest on it
+  double uses = 0;         // composed factors (the joined chain, carried loops) that rest on it
+  double plane_uses = 0;   // carried plane observations that rest on it
+  double chain_scale = 0;  // what each composed factor multiplies its covariance by (Share)
+  double plane_scale = 0;  // and each carried plane observation
 };
+
+// The weights: equal within each group, the planes' group sparsify_plane_share of the whole
+// when both groups rest on the hop.
+void Share(Hop& h, double plane_share) {
+  const bool both = h.uses > 0 && h.plane_uses > 0;
+  h.chain_scale = both ? h.uses / (1.0 - plane_share) : h.uses;
+  h.plane_scale = both ? h.plane_uses / plane_share : h.plane_uses;
+}
 
 Hop MakeHop(const KeyframeNode& to) {
   Hop h;
@@ -139,8 +153,10 @@ bool SGraph::Impl::RemovalLosesNothing(std::uint32_t v) {
       continue;
     if (Route(f.a == v ? f.b : f.a, p, n, a, b) == Via::kNowhere) return false;
   }
-  // Plane observations are dropped with their keyframe, never carried: a plane whose every
-  // live observation is v's would be left unmeasured (held where it is, with no marginal).
+  // Plane observations go through a hop (both are usable here) unless carrying is off: then a
+  // plane whose every live observation is v's would be left unmeasured (held where it is, with
+  // no marginal).
+  if (config.sparsify_plane_share > 0) return true;
   MarkLastObservers();
   return !keyframes[v].last_observer;
 }
@@ -176,9 +192,10 @@ bool SGraph::Impl::Sparsify() {
   MarkLastObservers();
   // The victim, cheapest loss first: no loop closure on it; then loops that can be carried
   // (a hop with a measurement to carry them through), fewest first; then the rest. Within each
-  // of those, a keyframe that is some plane's last observer after the others (a loop weighs
-  // more than a plane seen once), then the shortest hop between its neighbours (the most
-  // redundant keyframe). Never the origin, never in the local window.
+  // of those, a keyframe that would leave some plane unobserved (its last observer, with no hop
+  // to carry the observation through, or carrying off) after the others (a loop weighs more
+  // than a plane seen once), then the shortest hop between its neighbours (the most redundant
+  // keyframe). Never the origin, never in the local window.
   std::int32_t victim = kNone;
   int best_tier = 6;
   std::uint32_t best_loops = 0;
@@ -187,11 +204,15 @@ bool SGraph::Impl::Sparsify() {
        k != kNone && k != window_start; k = keyframes[static_cast<std::size_t>(k)].next) {
     const KeyframeNode& node = keyframes[static_cast<std::size_t>(k)];
     if (node.prev == kNone || node.next == kNone) continue;
+    // Information enters the chain only through AddRelative, which refuses any that is not
+    // positive definite, so a non-zero one is a usable hop (MakeHop) without its factorisation.
     const bool carriable =
         !node.information_from_prev.isZero(0.0) ||
         !keyframes[static_cast<std::size_t>(node.next)].information_from_prev.isZero(0.0);
+    // A last observer whose observations can be carried loses nothing a plane needs.
+    const bool strands_a_plane = node.last_observer && !(carriable && config.sparsify_plane_share > 0);
     const int tier =
-        2 * (node.loop_factors == 0 ? 0 : (carriable ? 1 : 2)) + (node.last_observer ? 1 : 0);
+        2 * (node.loop_factors == 0 ? 0 : (carriable ? 1 : 2)) + (strands_a_plane ? 1 : 0);
     const double hop = (Pose(static_cast<std::uint32_t>(node.prev)).translation() -
                         Pose(static_cast<std::uint32_t>(node.next)).translation())
                            .norm();
@@ -223,15 +244,24 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t
   const auto touches = [v](const FactorRecord& f) {
     return f.active && f.kind == FactorKind::kRelative && !f.chain && (f.a == v || f.b == v);
   };
-  // 1. How many composed factors rest on each hop.
+  const bool carry_planes = config.sparsify_plane_share > 0;
+  const auto observes = [v](const FactorRecord& f) {
+    return f.active && f.kind == FactorKind::kPlane && f.a == v;
+  };
+  // A plane observation is no partner keyframe: v stands for it in Route (neither neighbour).
+  const Via plane_via = carry_planes ? Route(v, p, n, a, b) : Via::kNowhere;
+  // 1. How many carried factors rest on each hop, and the share each gets.
   a.uses = b.uses = compose ? 1.0 : 0.0;
   for (std::size_t i = 0; i < factor_high_water; ++i) {
     const FactorRecord& f = factors[i];
-    if (!touches(f)) continue;
-    const Via via = Route(f.a == v ? f.b : f.a, p, n, a, b);
-    if (via == Via::kPrev) a.uses += 1;
-    if (via == Via::kNext) b.uses += 1;
+    const Via via = touches(f)     ? Route(f.a == v ? f.b : f.a, p, n, a, b)
+                    : observes(f) ? plane_via
+                                  : Via::kNowhere;
+    Hop* h = via == Via::kPrev ? &a : via == Via::kNext ? &b : nullptr;
+    if (h != nullptr) (observes(f) ? h->plane_uses : h->uses) += 1;
   }
+  Share(a, config.sparsify_plane_share);
+  Share(b, config.sparsify_plane_share);
   // 2. Carry every factor that is not a chain hop (loops) from v to a neighbour t, as
   //    partner k -> t. Each is removed before its replacement is added, so the factor store
   //    always has room. The replacement touches neither v nor a factor still to be visited.
@@ -260,15 +290,15 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t
     Eigen::Isometry3d Z_kt;
     Matrix6d sigma_kt;
     std::uint32_t t = 0;
-    if (via == Via::kNext) {  // Z_kn = Z_kv B: Ad(B^-1) Sigma_kv Ad(B^-1)^T + uses_b Sigma_b
+    if (via == Via::kNext) {  // Z_kn = Z_kv B: Ad(B^-1) Sigma_kv Ad(B^-1)^T + s_b Sigma_b
       const Matrix6d Ad = Adjoint(b.Z.inverse());
       Z_kt = Z_kv * b.Z;
-      sigma_kt = Ad * covariance * Ad.transpose() + b.uses * b.covariance;
+      sigma_kt = Ad * covariance * Ad.transpose() + b.chain_scale * b.covariance;
       t = n;
-    } else {  // Z_kp = Z_kv A^-1: Ad(A) (Sigma_kv + uses_a Sigma_a) Ad(A)^T
+    } else {  // Z_kp = Z_kv A^-1: Ad(A) (Sigma_kv + s_a Sigma_a) Ad(A)^T
       const Matrix6d Ad = Adjoint(a.Z);
       Z_kt = Z_kv * a.Z.inverse();
-      sigma_kt = Ad * (covariance + a.uses * a.covariance) * Ad.transpose();
+      sigma_kt = Ad * (covariance + a.chain_scale * a.covariance) * Ad.transpose();
       t = p;
     }
     Matrix6d information_kt;
@@ -281,13 +311,34 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t
       ++stats.sparsify_dropped;
     }
   }
-  // 3. Detach: forget the chain hops and plane observations on v (their measurements are in
-  //    the hops, or go with v), then let Ceres drop their residuals with v's parameters.
+  // 3. Carry every plane observation on v to the neighbour its hop leads to, as t would have
+  //    made it: through A to p (T_p_v = A), or through B to n (T_n_v = B^-1, whose right
+  //    perturbation has covariance Ad(B) Sigma_b Ad(B)^T).
+  if (plane_via != Via::kNowhere) {
+    const bool next = plane_via == Via::kNext;
+    const std::uint32_t t = next ? n : p;
+    const Eigen::Isometry3d T_t_v = next ? b.Z.inverse() : a.Z;
+    Matrix6d hop_covariance = next ? b.plane_scale * b.covariance : a.plane_scale * a.covariance;
+    if (next) hop_covariance = (Adjoint(b.Z) * hop_covariance * Adjoint(b.Z).transpose()).eval();
+    for (std::size_t i = 0; i < factor_high_water; ++i) {
+      if (!observes(factors[i])) continue;  // a carried one is on t, never on v
+      bool fused = false;
+      if (CarryPlaneObservation(static_cast<std::int32_t>(i), t, T_t_v, hop_covariance, fused)) {
+        ++stats.sparsify_planes_carried;
+        if (fused) ++stats.sparsify_planes_fused;
+      } else {
+        ++stats.sparsify_planes_dropped;
+      }
+    }
+  }
+  // 4. Detach: forget the chain hops and the plane observations left on v (their measurements
+  //    are in the hops, or go with v), then let Ceres drop their residuals with v's parameters.
   for (std::size_t i = 0; i < factor_high_water; ++i) {
     const FactorRecord& f = factors[i];
     if (!f.active) continue;
     if ((f.kind == FactorKind::kRelative && (f.a == v || f.b == v)) ||
         (f.kind == FactorKind::kPlane && f.a == v)) {
+      if (f.kind == FactorKind::kPlane) ++stats.sparsify_planes_dropped;
       DropFactor(static_cast<std::int32_t>(i));
     }
   }
@@ -303,11 +354,12 @@ void SGraph::Impl::RemoveKeyframe(std::uint32_t v, std::span<const std::uint32_t
   free_keyframe_slots.push_back(static_cast<std::int32_t>(v));  // reserved at Init: no allocation
   --active_keyframes;
   if (had_loops) ++stats.sparsified_with_loops;
-  // 4. Join the neighbours: Z = A B, Sigma = Ad(B^-1) uses_a Sigma_a Ad(B^-1)^T + uses_b Sigma_b.
+  // 5. Join the neighbours: Z = A B, Sigma = Ad(B^-1) s_a Sigma_a Ad(B^-1)^T + s_b Sigma_b
+  //    (s: each hop's chain_scale).
   //    Without a measurement on one side the chain was already cut there: nothing to join.
   if (compose) {
     const Matrix6d Ad = Adjoint(b.Z.inverse());
-    const Matrix6d sigma = Ad * (a.uses * a.covariance) * Ad.transpose() + b.uses * b.covariance;
+    const Matrix6d sigma = Ad * (a.chain_scale * a.covariance) * Ad.transpose() + b.chain_scale * b.covariance;
     Matrix6d information;
     if (!Invert(sigma, information) ||
         !AddRelative(p, n, a.Z * b.Z, information, RelativePoseKind::kSparsified)) {

@@ -235,6 +235,9 @@ bool ParseNodeConfig(const std::string& text,
   r.Float("mapping", "min_range_m", 0.0, 10.0, c.mapper.min_range_m);
   r.Float("mapping", "max_range_m", 1.0, 120.0, c.mapper.max_range_m);
   r.Integer("mapping", "max_keyframes", 16, 1000000, c.mapper.graph.max_keyframes);
+  // The share of a removed keyframe's hop that its carried plane observations get (0: dropped;
+  // s_graph.hpp, sparsify_plane_share). Below 1: the joined chain always keeps a share.
+  r.Number("mapping", "sparsify_plane_share", 0.0, 0.99, c.mapper.graph.sparsify_plane_share);
   r.Integer("mapping", "cloud_store_points", 100000, 100000000, c.mapper.cloud_store_points);
   // The full solve on its own thread, applied this many keyframes after it began (0: on the
   // SLAM thread; local_mapper.hpp, full_solve_lag_keyframes).
@@ -366,7 +369,7 @@ std::uint32_t MapperSettingsCrc(const core::LocalMapperConfig& m) {
                      m.odometry_rotation_sigma_min, m.odometry_gate_chi2, m.motion_seed_max_age_s,
                      m.base_height_m, m.keyframe_spacing_m, m.keyframe_angle_rad,
                      static_cast<double>(m.min_range_m), static_cast<double>(m.max_range_m),
-                     static_cast<double>(m.graph.max_keyframes),
+                     static_cast<double>(m.graph.max_keyframes), m.graph.sparsify_plane_share,
                      static_cast<double>(m.cloud_store_points),
                      static_cast<double>(m.full_solve_lag_keyframes),
                      static_cast<double>(m.grid.width), static_cast<double>(m.grid.height),

@@ -209,9 +209,11 @@ void Node::Impl::PrintReport() {
   const core::SGraphStats gs = mapper.graph().stats();
   Appendf(text,
           "  graph: %zu keyframes (peak %zu of max_keyframes %zu), %zu sparsified, %" PRIu64
-          " removed on request, %" PRIu64 " refused (store full); %zu factors\n",
+          " removed on request, %" PRIu64 " refused (store full); %zu factors; plane observations of "
+          "removed keyframes %zu carried (%zu fused), %zu dropped\n",
           gs.keyframes, gs.keyframes_peak, mapper.graph().config().max_keyframes, gs.sparsified,
-          gs.removed_keyframes, gs.rejected_keyframes, gs.factors);
+          gs.removed_keyframes, gs.rejected_keyframes, gs.factors, gs.sparsify_planes_carried,
+          gs.sparsify_planes_fused, gs.sparsify_planes_dropped);
   const core::CollabPublisherStats& ps = publisher.stats();
   Appendf(text,
           "  wall marginals: %" PRIu64 " computed (%" PRIu64 " failed), %" PRIu64
@@ -311,9 +313,11 @@ void Node::Impl::PrintReport() {
           ps.own_solve_failures);
   Appendf(stats,
           "graph_keyframes %zu\ngraph_keyframes_peak %zu\ngraph_sparsified %zu\ngraph_removed %" PRIu64
-          "\ngraph_refused %" PRIu64 "\ngraph_factors %zu\n",
+          "\ngraph_refused %" PRIu64 "\ngraph_factors %zu\ngraph_planes_carried %zu"
+          "\ngraph_planes_fused %zu\ngraph_planes_dropped %zu\n",
           gs.keyframes, gs.keyframes_peak, gs.sparsified, gs.removed_keyframes,
-          gs.rejected_keyframes, gs.factors);
+          gs.rejected_keyframes, gs.factors, gs.sparsify_planes_carried, gs.sparsify_planes_fused,
+          gs.sparsify_planes_dropped);
   Appendf(stats,
           "cloud_store_clouds %zu\ncloud_store_evicted_covered %" PRIu64 "\ncloud_store_evicted_uncovered %" PRIu64
           "\ncloud_cover_cell_m %.2f\n",

@@ -67,6 +67,16 @@ struct SGraphConfig {
   /// keyframe (a full solve, sparsification). false: summed afresh at every local solve, at a
   /// cost that grows with the mission (the reference the incremental sum is tested against).
   bool incremental_held_sums = true;
+  /// Sparsification carries a removed keyframe's plane observations to a neighbour through a
+  /// hop (docs/s-graph.md, "Sparsification"). A hop that several carried factors rest on enters
+  /// each inflated (covariance intersection); this is the share of the hop that the carried
+  /// plane observations get together, the rest going to the joined chain and the carried loops.
+  /// 0: plane observations are dropped, not carried. Below 1: the chain always keeps a share.
+  /// Any value in (0, 1) is consistent; 0.8 mapped best of 0.2 / 0.5 / 0.8 / 0.95 on a 1-hour
+  /// office recording and two generated buildings (docs/performance.md, "plane observations
+  /// carried"): a wall seen from a removed keyframe has no other route into the graph, the
+  /// neighbours are tied by scan matching and loops besides the chain.
+  double sparsify_plane_share = 0.8;
   /// Full solve (after a loop closure and every so often): everything but the origin moves.
   int full_max_iterations = 100;
   double full_max_seconds = 2.0;
@@ -115,7 +125,9 @@ struct MapPlane {
   Eigen::Vector3d basis_v = Eigen::Vector3d::UnitZ();
   PlaneClass plane_class = PlaneClass::kWall;
   std::uint32_t observations = 0;  ///< observations ever added (how established it is)
-  /// Observations in the graph now: sparsification and RemoveKeyframe drop a removed keyframe's.
+  /// Observations in the graph now: sparsification and RemoveKeyframe carry a removed
+  /// keyframe's to a neighbour (fused with the neighbour's own where it has one), or drop them
+  /// with SGraphConfig::sparsify_plane_share = 0 or a carry that fails (sparsify_planes_dropped).
   /// Zero means nothing measures the plane any more (its estimate stays, its marginal is
   /// undefined: PlaneMarginals refuses it).
   std::uint32_t live_observations = 0;
@@ -156,6 +168,11 @@ struct SGraphStats {
   // counted, and lost (sparsification at a full store only; docs/s-graph.md).
   std::size_t sparsified_with_loops = 0, sparsify_carried = 0, sparsify_merged = 0,
               sparsify_dropped = 0;
+  /// Plane observations of removed keyframes carried to a neighbour, of them fused into the
+  /// neighbour's own observation of the same plane, and those not carried (no hop with a
+  /// measurement, a covariance that is not positive definite, sparsify_plane_share 0).
+  std::size_t sparsify_planes_carried = 0, sparsify_planes_fused = 0,
+              sparsify_planes_dropped = 0;
   /// Keyframes refused because the store was full and nothing could be sparsified, and
   /// sparsifications that found nothing to remove. Both stay 0 under a validated config (a
   /// keyframe always lies between the origin and the local window); never a write past the store.
@@ -163,8 +180,9 @@ struct SGraphStats {
   /// Keyframes removed on request (RemoveKeyframe), not counted in `sparsified`.
   std::uint64_t removed_keyframes = 0;
   /// Planes whose last live observation went: with its keyframe, by sparsification at a full
-  /// store (which takes a plane's last observer only when every candidate of the same loop
-  /// tier is one; a removal on request never does), or by RemoveFactor. Such a plane keeps its
+  /// store with carrying off (which then takes a plane's last observer only when every
+  /// candidate of the same loop tier is one; a removal on request never does) or a carry that
+  /// failed, or by RemoveFactor. Such a plane keeps its
   /// estimate; PlaneMarginals refuses it (MapPlane::live_observations).
   std::uint64_t planes_unobserved = 0;
   std::size_t planes = 0, rooms = 0, floors = 0;
@@ -233,15 +251,18 @@ class SGraph {
 
   /// Removes a keyframe as sparsification does (docs/s-graph.md): its loop closures carried to
   /// a neighbour through the hop that leads there, its neighbours joined by the composition of
-  /// its two hops, its plane observations dropped, its slot freed for a later keyframe. For a
+  /// its two hops, its plane observations carried to a neighbour (dropped with
+  /// sparsify_plane_share = 0), its slot freed for a later keyframe. For a
   /// caller that knows the keyframe is redundant (a revisit of a place another keyframe keeps).
   /// A carried loop is another factor (it may take another id, or be fused into a parallel
   /// one), so a caller that holds loop factor ids (loops still to be judged) passes them as
   /// `keep_factors`: a keyframe one of them ends at is kept, and no loop is fused into one.
   /// kNotFound for an inactive id; kInvalidArgument for the origin, a keyframe in the local
   /// window, one a kept factor ends at, or one whose removal would lose a constraint (a loop
-  /// with no hop to carry it, a hop without a measurement, a plane's last live observation):
-  /// unlike sparsification at a full store, a removal on request never drops anything. A
+  /// with no hop to carry it, a hop without a measurement, with carrying off a plane's last
+  /// live observation): unlike sparsification at a full store, a removal on request drops
+  /// nothing a validated hop can carry (a carry whose covariance is numerically singular is
+  /// still dropped and counted: sparsify_planes_dropped). A
   /// background job begun before keeps what it borrowed (ApplyFullSolve skips the keyframe).
   Status RemoveKeyframe(std::uint32_t id, std::span<const std::uint32_t> keep_factors = {});
 
