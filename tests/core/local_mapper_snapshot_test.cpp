@@ -56,14 +56,18 @@ WalkResult WalkOf(std::size_t lag, std::size_t save_from, SaveBy by = SaveBy::kS
   for (std::size_t i = 0; i < walk.truth.size(); ++i) {
     if (by == SaveBy::kRequest && save_due && !mapper->snapshot_requested()) {
       bytes.assign(mapper->SnapshotBytes(), 0);
+      test::AllocationScope scope;
       mapper->RequestSnapshot(bytes);
+      out.save_allocations += scope.allocations();
     }
     EXPECT_TRUE(FeedStep(*mapper, config, walk, i, times));
     Expected<std::size_t> n = Error{Errc::kInvalidArgument};
     if (save_from > 0 && i >= save_from && (i - save_from) % 11 == 0) save_due = true;
     if (!save_due) continue;
     if (by == SaveBy::kRequest) {
+      test::AllocationScope scope;
       auto taken = mapper->TakeSnapshot();
+      out.save_allocations += scope.allocations();
       if (!taken) continue;  // no keyframe yet, or a solve pending at each
       n = *taken;
     } else {
@@ -147,6 +151,7 @@ TEST(LocalMapperSnapshot, ASnapshotAskedForIsTakenBetweenSolvesAndTheWalkGoesOnB
   const WalkResult restored = WalkOf(5, 7, SaveBy::kRequest);
   ASSERT_FALSE(HasFailure());
   EXPECT_GE(restored.saves, 3u);  // steps 7, 18, 29, 40: each served within a few keyframes
+  EXPECT_EQ(restored.save_allocations, 0u) << "asking for a snapshot and taking it";
   // Some were taken with a solve wanted and not begun: the load began it, as live.
   EXPECT_GE(restored.loads_that_began_a_solve, 1u);
   ExpectSameWalk(reference, restored);

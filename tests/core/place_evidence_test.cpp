@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "alloc_counter.hpp"
@@ -100,31 +101,54 @@ constexpr double kClearanceM = 0.3;  // FreeSpaceConflictConfig::clearance_m
 constexpr std::size_t kMinCells = 5;  // min_stretch_m (1 m) in 0.2 m cells
 constexpr double kMarginRatio = 1.5;  // MergeRuleConfig::margin_ratio
 
-TEST(PlaceEvidence, TheDuelSetsAsideWhatThePointsContradictAndTheTruthMerges) {
-  const PlanBuilding building = IdenticalRooms();
-  Views v;
-  v.seen_a = {{0, 0, 42}, {1}, {2}, {3}, {4}, {5}, {6}, {7}};  // rooms 0-6: wherever a shift takes the cabinet
-  Robot a(building, v.seen_a, v.Ta);
-  Robot b(building, v.seen_b, v.Tb);
-  AddBox(a);
-  AddBox(b);
+// Robot a saw rooms 0-6 with the cabinet wherever a shift by one room takes it: before any
+// place, the rule cannot tell the truth from that shift (kAmbiguous).
+struct Undecided {
+  PlanBuilding building = IdenticalRooms();
+  Views v = [] {
+    Views w;
+    w.seen_a = {{0, 0, 42}, {1}, {2}, {3}, {4}, {5}, {6}, {7}};
+    return w;
+  }();
+  Robot a{building, v.seen_a, v.Ta};
+  Robot b{building, v.seen_b, v.Tb};
   AlignmentSearch search;
-  ASSERT_TRUE(search.Init({}));
   PlaceScorer scorer;
-  scorer.Init(4000);
   PlaceChooser chooser;
-  chooser.Init(1 << 19);
+  BoundedVector<PlanarTransform> set_aside;
+  MergeInputs in;
+  MergeDecision d;
+  Undecided() {
+    AddBox(a);
+    AddBox(b);
+    EXPECT_TRUE(search.Init({}));
+    scorer.Init(4000);
+    chooser.Init(1 << 19);
+    set_aside.Init(8);
+    search.Search(a.walls, {}, b.walls, {}, {}, false);
+    in = test::InputsOf(a, b, search);
+    d = DecideMerge(in, search, {}, nullptr);  // the rule's first decision
+  }
+};
+
+TEST(PlaceEvidence, TheDuelSetsAsideWhatThePointsContradictAndTheTruthMerges) {
+  Undecided u;
+  const PlanBuilding& building = u.building;
+  const Views& v = u.v;
+  Robot& a = u.a;
+  Robot& b = u.b;
+  AlignmentSearch& search = u.search;
+  PlaceScorer& scorer = u.scorer;
+  PlaceChooser& chooser = u.chooser;
+  BoundedVector<PlanarTransform>& set_aside = u.set_aside;
+  MergeInputs& in = u.in;
+  MergeDecision d = u.d;
   const PlaceEvidenceConfig config;
   const PlanarTransform truth = Truth(a, b);
   // As the session does (collab_places.cpp): weigh the decision on the places held; while they
   // cannot tell the leader from its blocker, ask for a place that can.
   std::vector<Eigen::Vector2d> places;  // b's map frame
   std::vector<std::vector<Eigen::Vector3f>> clouds;
-  BoundedVector<PlanarTransform> set_aside;
-  set_aside.Init(8);
-  search.Search(a.walls, {}, b.walls, {}, {}, false);
-  MergeInputs in = test::InputsOf(a, b, search);
-  MergeDecision d = DecideMerge(in, search, {}, nullptr);
   ASSERT_EQ(d.verdict, MergeVerdict::kAmbiguous) << ToString(d.verdict);
   for (std::size_t asked = 0;; ++asked) {
     std::vector<PlaceView> views;
@@ -287,6 +311,43 @@ TEST(PlaceEvidence, CodingAndScoringAllocateNothing) {
   EXPECT_EQ(scope.allocations(), 0u);
   EXPECT_TRUE(encoded && decoded_ok);
   EXPECT_GT(t.explained, 0u);
+}
+
+// place_decision.hpp and place_evidence.hpp promise no allocation after Init: the weighing of
+// an undecided merge on the places held (none, then one) and the choice of the next place.
+TEST(PlaceEvidence, WeighingOnPlacesAndChoosingOneAllocateNothing) {
+  Undecided u;
+  const PlanBuilding& building = u.building;
+  const Views& v = u.v;
+  Robot& a = u.a;
+  Robot& b = u.b;
+  MergeInputs& in = u.in;
+  const MergeDecision& d = u.d;
+  const PlaceEvidenceConfig config;
+  ASSERT_EQ(d.verdict, MergeVerdict::kAmbiguous) << ToString(d.verdict);
+  std::vector<Eigen::Vector2d> places;
+  places.reserve(1);
+  PlaceDecision pd;
+  std::optional<Eigen::Vector2d> chosen;
+  {
+    test::AllocationScope scope;
+    pd = DecideWithPlaces(in, u.search, {}, d, {}, 0.2, u.scorer, u.set_aside);
+    if (pd.wants_place) chosen = u.chooser.Choose(b.walls, b.free, a.free, pd.first, pd.second, places, config);
+    EXPECT_EQ(scope.allocations(), 0u) << "no place held";
+  }
+  ASSERT_TRUE(pd.wants_place);
+  ASSERT_TRUE(chosen.has_value());
+  places.push_back(*chosen);
+  const std::vector<Eigen::Vector3f> cloud =
+      PlaceCloudOf(building, v.seen_b, b, b.T_map_world.inverse() * *chosen, config.radius_m, true);
+  const PlaceView views[1] = {{*chosen, cloud}};
+  in.set_aside = {};
+  {
+    test::AllocationScope scope;
+    pd = DecideWithPlaces(in, u.search, {}, d, views, 0.2, u.scorer, u.set_aside);
+    EXPECT_EQ(scope.allocations(), 0u) << "one place held";
+  }
+  EXPECT_GT(pd.duels, 0u) << "the place was weighed";
 }
 
 }  // namespace

@@ -233,5 +233,48 @@ TEST(SGraphBackground, BeginAndApplyAllocateNothing) {
   EXPECT_EQ(apply_allocations, 0u);
 }
 
+// A room factor has 9 parameter blocks, every other kind at most 4: the job's references to
+// the copied blocks must hold a factor store full to its last slot with every room in it.
+// Counted after a first round on a store still half empty (that round sizes Ceres' scratch
+// vectors the graph keeps), so that only what the full store needs beyond it can allocate.
+TEST(SGraphBackground, AStoreFullToItsLastSlotWithRoomsIsCopiedWithoutAllocating) {
+  SGraphConfig config;
+  config.max_keyframes = 256;
+  std::size_t peak = 0;
+  {
+    RoomRow probe(config);
+    WalkAndClose(probe, 60);
+    peak = probe.graph.stats().factors_peak;
+  }
+  config.max_factors = peak;
+  RoomRow row(config);
+  SGraphSolveJob job;
+  ASSERT_TRUE(job.Init(config));
+  for (int i = 0; i < 30; ++i) {
+    row.Step();
+    ASSERT_TRUE(row.graph.Solve(SolveKind::kLocal));
+  }
+  ASSERT_TRUE(row.graph.BeginFullSolve(job));
+  job.Complete();
+  ASSERT_TRUE(row.graph.ApplyFullSolve(job));
+  for (int i = 30; i < 60; ++i) {
+    row.Step();
+    ASSERT_TRUE(row.graph.Solve(SolveKind::kLocal));
+  }
+  ASSERT_TRUE(row.graph.AddRelativePose(row.ids.front(), row.ids.back(), row.truth.front().inverse() * row.truth.back(),
+                                        OdometryInformation(), RelativePoseKind::kLoopClosure));
+  ASSERT_EQ(row.graph.stats().factors_peak, config.max_factors) << "the store is full";
+  ASSERT_GE(row.graph.stats().room_factors, 5u);
+  std::size_t allocations = 0;
+  {
+    test::AllocationScope scope;
+    ASSERT_TRUE(row.graph.BeginFullSolve(job));
+    allocations = scope.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  job.Complete();
+  EXPECT_TRUE(row.graph.ApplyFullSolve(job));
+}
+
 }  // namespace
 }  // namespace msgraphs::core

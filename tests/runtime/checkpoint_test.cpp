@@ -17,6 +17,7 @@
 #include <memory>
 #include <thread>
 
+#include "alloc_counter.hpp"
 #include "box_room_walk.hpp"
 #include "msgraphs/core/collab/distilled_codec.hpp"
 
@@ -432,6 +433,47 @@ TEST(Checkpoint, AnotherRobotsFolderIsRefusedAndOtherMapperSettingsStartAfresh) 
   EXPECT_EQ(changed.mapper.stats().keyframes, 0u);
   EXPECT_GE(changed.restored.set_aside.size(), 3u);
   for (const std::string& why : changed.restored.set_aside) std::printf("set aside: %s\n", why.c_str());
+  fs::remove_all(killed.dir);
+}
+
+// ParseCheckpoint (checkpoint_file.hpp) allocates nothing: a whole snapshot file checked and
+// parsed, one with a flipped byte refused, another robot's refused.
+TEST(Checkpoint, ParsingASnapshotFileAllocatesNothing) {
+  const core::Walk walk(static_cast<int>(kSteps));
+  const KilledWalk killed = WalkAndKill("parse", walk);
+  ASSERT_FALSE(HasFailure());
+  std::string newest;
+  std::uint64_t newest_generation = 0;
+  for (const auto& entry : fs::directory_iterator(killed.dir)) {
+    bool is_snapshot = false;
+    std::uint64_t generation = 0;
+    const std::string name = entry.path().filename().string();
+    if (CheckpointGeneration(name, is_snapshot, generation) && is_snapshot && generation > newest_generation) {
+      newest = entry.path().string();
+      newest_generation = generation;
+    }
+  }
+  ASSERT_FALSE(newest.empty()) << "no snapshot written";
+  std::ifstream in(newest, std::ios::binary);
+  const std::vector<std::uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::uint8_t> flipped = file;
+  flipped[flipped.size() / 2] ^= 0x40;
+  bool parsed = false, refused = false, other_refused = false;
+  std::uint32_t messages = 0;
+  {
+    test::AllocationScope scope;
+    const auto p = ParseCheckpoint(file, 1);
+    parsed = p.has_value() && !p->mapper.empty();
+    if (p) messages = p->session_messages;
+    refused = !ParseCheckpoint(flipped, 1).has_value();
+    const auto other = ParseCheckpoint(file, 2);
+    other_refused = !other.has_value() && other.error().code == Errc::kInvalidConfig;
+    EXPECT_EQ(scope.allocations(), 0u);
+  }
+  EXPECT_TRUE(parsed);
+  EXPECT_GT(messages, 0u);
+  EXPECT_TRUE(refused);
+  EXPECT_TRUE(other_refused);
   fs::remove_all(killed.dir);
 }
 

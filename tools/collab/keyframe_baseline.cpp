@@ -91,7 +91,7 @@ void MatchKeyframes(Mission& mission, Robot& a) {
     changed = true;
   }
   if (!changed) return;
-  state.collab.Clear();
+  state.collab.BeginUpdate();
   state.rejected_consistency = 0;
   for (auto& [b_index, list] : state.matches) {
     std::vector<std::uint32_t> keep(std::min<std::size_t>(list.size(), 64));

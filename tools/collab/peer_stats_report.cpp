@@ -29,12 +29,12 @@ std::string PeerStatsLine(int viewer, const core::CollabPeerStats& p, std::size_
 }
 
 std::string SessionStatsLine(int robot, const core::CollabSessionStats& st) {
-  char b[1024];
+  char b[1280];
   std::snprintf(
       b, sizeof b,
       "robot %d session: %zu own rooms (peak room cloud %zu points), %zu peers, stores %.1f MB; "
       "refused: rooms %llu, clouds too large %llu, descriptors %llu, pending %llu, matches %llu; "
-      "cache evictions %llu; solves %llu (%llu failed); marginal wall covariances %llu times "
+      "cache evictions %llu; solves %llu (%llu failed; factors %llu added, %llu kept, %llu removed); marginal wall covariances %llu times "
       "(%llu fell back; %llu solved without peers' priors, %llu of those failed); places: %llu asked, %llu received, %llu served, %llu refused, %llu "
       "unanswered, %llu unsolicited; %llu decisions weighed on them, %llu transforms set aside\n",
       robot, st.own_rooms, st.room_points_peak, st.peers, static_cast<double>(st.store_bytes) / 1e6,
@@ -46,6 +46,9 @@ std::string SessionStatsLine(int robot, const core::CollabSessionStats& st) {
       static_cast<unsigned long long>(st.cache_evictions),
       static_cast<unsigned long long>(st.solves),
       static_cast<unsigned long long>(st.solve_failures),
+      static_cast<unsigned long long>(st.solve_factors_added),
+      static_cast<unsigned long long>(st.solve_factors_kept),
+      static_cast<unsigned long long>(st.solve_factors_removed),
       static_cast<unsigned long long>(st.marginal_updates),
       static_cast<unsigned long long>(st.marginal_failures),
       static_cast<unsigned long long>(st.own_evidence_jobs),
@@ -107,6 +110,9 @@ void WriteSessionStats(JsonWriter& json, const core::CollabSessionStats& st) {
   json.Field("cache_evictions", st.cache_evictions);
   json.Field("solves", st.solves);
   json.Field("solve_failures", st.solve_failures);
+  json.Field("solve_factors_added", st.solve_factors_added);
+  json.Field("solve_factors_kept", st.solve_factors_kept);
+  json.Field("solve_factors_removed", st.solve_factors_removed);
   json.Field("marginal_updates", st.marginal_updates);
   json.Field("marginal_failures", st.marginal_failures);
   json.Field("own_evidence_jobs", st.own_evidence_jobs);
@@ -122,6 +128,8 @@ void WriteSessionStats(JsonWriter& json, const core::CollabSessionStats& st) {
   json.Field("solve_room_pairs", st.solve_room_pairs);
   json.Field("solve_wall_pairs", st.solve_wall_pairs);
   json.Field("solve_origin_measurements", st.solve_origin_measurements);
+  json.Field("solve_room_wall_edges", st.solve_room_wall_edges);
+  json.Field("solve_room_wall_refused", st.solve_room_wall_refused);
   json.Field("malformed", st.malformed);
   json.EndObject();
 }

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: MIT
-// The collaborative graph of the merged peers (collaborative_graph.hpp): each merged peer's
-// origin starts at its merge (or the previous estimate when that is the same placement); room
-// matches the merge agrees with are tied room to room (corridors across their axis only), with
-// their walls wall to wall, and their fine alignments measure the origin directly; with fewer
-// than two such rooms (corridors not counted), the walls the merge lays on each other tie the
-// maps (wall to wall in the walls modes only). The wall pairs behind the priors that feed it all
-// back into the local S-Graph are collected in every mode: feedback is its own switch.
+// The collaborative graph of the merged peers (collaborative_graph.hpp), one update per solve:
+// each merged peer's origin starts at its merge (or keeps its estimate when that is the same
+// placement); room matches the merge agrees with are tied room to room (corridors across their
+// axis only), with their walls wall to wall, and their fine alignments measure the origin
+// directly; with fewer than two such rooms (corridors not counted), the walls the merge lays
+// on each other tie the maps (wall to wall in the walls modes only). The wall pairs behind the
+// priors that feed it all back into the local S-Graph are collected in every mode: feedback is
+// its own switch.
 #include <cmath>
 
 #include "collab_session_impl.hpp"
@@ -14,10 +15,11 @@
 namespace msgraphs::core {
 
 void CollabSession::Impl::Solve() {
-  graph.Clear();
+  graph.BeginUpdate();
   wall_pairs.clear();
   stats.graph_refused = 0;
   stats.solve_room_pairs = stats.solve_wall_pairs = stats.solve_origin_measurements = 0;
+  stats.solve_room_wall_edges = stats.solve_room_wall_refused = 0;
   const DistilledGraph& mine = own_graph;
   const double cos_pair = std::cos(config.wall_pair_angle_rad);
   // A pair of coinciding walls: tied wall to wall in the walls modes, and in every mode kept for
@@ -111,9 +113,29 @@ void CollabSession::Impl::Solve() {
   }
   // Everything else each merged robot mapped is attached too (one factor each: it does not move
   // the estimate, but the graph then holds every robot's walls and rooms in this frame).
+  // Each room is tied to its walls (its centre midway between each facing pair, as in the
+  // local S-Graph), so that what ties rooms ties their walls too.
   auto attach = [&](std::uint16_t robot, const DistilledGraph& g, double floor) {
     for (const DistilledWall& w : g.walls) stats.graph_refused += graph.AddWall(robot, w) ? 0u : 1u;
-    for (const DistilledRoom& r : g.rooms) stats.graph_refused += graph.AddRoom(robot, r, floor) ? 0u : 1u;
+    for (const DistilledRoom& r : g.rooms) {
+      const auto room = graph.AddRoom(robot, r, floor);
+      if (!room) {
+        ++stats.graph_refused;
+        continue;
+      }
+      const std::size_t pairs = r.shape == RoomShape::kCorridor ? 1 : 2;
+      for (std::size_t k = 0; k < pairs; ++k) {
+        const DistilledWall* A = r.walls[2 * k] < 0 ? nullptr : g.FindWall(static_cast<std::uint32_t>(r.walls[2 * k]));
+        const DistilledWall* B =
+            r.walls[2 * k + 1] < 0 ? nullptr : g.FindWall(static_cast<std::uint32_t>(r.walls[2 * k + 1]));
+        if (A == nullptr || B == nullptr) continue;
+        const auto wa = graph.AddWall(robot, *A), wb = graph.AddWall(robot, *B);
+        if (wa && wb && graph.AddRoomWalls(*room, *wa, *wb))
+          ++stats.solve_room_wall_edges;
+        else
+          ++stats.solve_room_wall_refused;
+      }
+    }
   };
   bool any_merged = false;
   for (Peer& p : peers) {
@@ -124,6 +146,9 @@ void CollabSession::Impl::Solve() {
   if (any_merged) attach(config.robot, mine, floor_z_m);
   ++stats.solves;
   if (!graph.Solve()) ++stats.solve_failures;
+  stats.solve_factors_added += graph.last_update().added;
+  stats.solve_factors_kept += graph.last_update().kept;
+  stats.solve_factors_removed += graph.last_update().removed;
   solved_version = own_graph.version;
   for (Peer& p : peers) {
     if (!p.used) continue;

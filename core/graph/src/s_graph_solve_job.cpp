@@ -38,9 +38,10 @@ Status SGraphSolveJob::Init(const SGraphConfig& config) {
   j.keyframe_in.assign(keyframes, 0);
   j.plane_in.assign(planes, 0);
   j.room_in.assign(rooms, 0);
-  // Every factor record is one residual block; a room's has the most parameter blocks (9).
+  // Every factor record is one residual block of at most 4 parameter blocks, except a room's
+  // (9: its centre and four planes' normal and offset), one per room.
   j.residuals.reserve(config.max_factors);
-  j.refs.reserve(config.max_factors * 4);
+  j.refs.reserve(config.max_factors * 4 + config.max_rooms * 5);
   j.marginal_ids.reserve(planes);
   j.marginal_blocks.reserve(planes);
   j.marginals.assign(planes, Eigen::Matrix3d::Zero());

@@ -205,9 +205,15 @@ struct CollabSessionStats {
   std::uint64_t searches = 0, searches_truncated = 0;
   /// At the last solve: rooms tied room to room, walls tied wall to wall, fine alignments used.
   std::size_t solve_room_pairs = 0, solve_wall_pairs = 0, solve_origin_measurements = 0;
+  /// At the last solve: rooms' room-to-wall edges (one per facing pair), and pairs refused
+  /// (walls not facing each other across the room's centre).
+  std::size_t solve_room_wall_edges = 0, solve_room_wall_refused = 0;
   std::uint64_t free_space_sent = 0, free_space_build_failures = 0;
   std::uint64_t log_entries = 0, log_dropped = 0;
   std::uint64_t solves = 0, solve_failures = 0;
+  /// Over all solves: the collaborative graph's factors added, kept (measurement updated in
+  /// place) and removed by their updates (CollaborativeGraph::last_update).
+  std::uint64_t solve_factors_added = 0, solve_factors_kept = 0, solve_factors_removed = 0;
   /// Distillations with marginal wall covariances, and those that fell back to conditional ones.
   std::uint64_t marginal_updates = 0, marginal_failures = 0;
   /// Rumour-free distillation (CollabPublisherStats): solved without peers' priors, and failed.
